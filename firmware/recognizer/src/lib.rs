@@ -1,0 +1,3 @@
+//! figurine's online recognizer (work in progress in this commit).
+#![no_std]
+#![forbid(unsafe_code)]

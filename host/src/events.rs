@@ -1,0 +1,126 @@
+//! Recognised-action events as the host sees them: the JSON lines of `figurine simulate`.
+//!
+//! One object per recognised action, in time order:
+//! `{"action":"jump","start":1.23,"end":2.01,"time":0.62,"weight":-0.31,"distance":1}`.
+//! This is the boundary between recognition and animation: `animate --events` reads it, the
+//! renderer draws it as a timeline, the device link prints it.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// One recognised action with its Laban efforts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ActionRecord {
+    /// Action name from the library (e.g. `"jump"`).
+    pub action: String,
+    /// Segment start, seconds on the log's clock.
+    pub start: f64,
+    /// Segment end, seconds on the log's clock.
+    pub end: f64,
+    /// Laban Time effort Lt in [-1, 1]: > 0 sudden, < 0 sustained.
+    pub time: f64,
+    /// Laban Weight effort Lw in [-1, 1]: > 0 strong, < 0 light.
+    pub weight: f64,
+    /// Edit distance of the approximate match (0 = exact).
+    pub distance: u32,
+}
+
+/// Why an event file could not be read.
+#[derive(Debug, Error)]
+pub enum EventsError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A line is not a valid event object.
+    #[error("{path}:{line}: {reason}")]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+/// Reads JSON-lines events from a file (blank lines ignored); errors name file and line.
+pub fn read_events_path(path: &Path) -> Result<Vec<ActionRecord>, EventsError> {
+    let file = std::fs::File::open(path).map_err(|source| EventsError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    read_events(file, path)
+}
+
+/// Reads JSON-lines events from any reader; `name` is used in error messages.
+pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>, EventsError> {
+    let mut out = Vec::new();
+    for (i, line) in BufReader::new(reader).lines().enumerate() {
+        let line = line.map_err(|e| EventsError::Malformed {
+            path: name.to_path_buf(),
+            line: i + 1,
+            reason: e.to_string(),
+        })?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let rec: ActionRecord =
+            serde_json::from_str(&line).map_err(|e| EventsError::Malformed {
+                path: name.to_path_buf(),
+                line: i + 1,
+                reason: e.to_string(),
+            })?;
+        if !(rec.start.is_finite() && rec.end.is_finite() && rec.end >= rec.start) {
+            return Err(EventsError::Malformed {
+                path: name.to_path_buf(),
+                line: i + 1,
+                reason: format!("bad segment times start={} end={}", rec.start, rec.end),
+            });
+        }
+        out.push(rec);
+    }
+    Ok(out)
+}
+
+/// Writes one event as a JSON line.
+pub fn write_event<W: Write>(mut w: W, rec: &ActionRecord) -> std::io::Result<()> {
+    let line = serde_json::to_string(rec).map_err(std::io::Error::other)?;
+    writeln!(w, "{line}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_contract_line_and_round_trips() {
+        let text =
+            r#"{"action":"jump","start":1.23,"end":2.01,"time":0.62,"weight":-0.31,"distance":1}"#;
+        let evs = read_events(text.as_bytes(), Path::new("e.jsonl")).unwrap();
+        assert_eq!(evs.len(), 1);
+        assert_eq!(evs[0].action, "jump");
+        assert_eq!(evs[0].distance, 1);
+        let mut out = Vec::new();
+        write_event(&mut out, &evs[0]).unwrap();
+        let back = read_events(&out[..], Path::new("x")).unwrap();
+        assert_eq!(back, evs);
+    }
+
+    #[test]
+    fn malformed_lines_name_file_and_line() {
+        let text = "\n{\"action\":\"a\",\"start\":0,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}\n{oops\n";
+        let err = read_events(text.as_bytes(), Path::new("e.jsonl")).unwrap_err();
+        assert!(err.to_string().starts_with("e.jsonl:3:"), "{err}");
+        let text =
+            "{\"action\":\"a\",\"start\":2,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}";
+        assert!(read_events(text.as_bytes(), Path::new("e")).is_err());
+    }
+}

@@ -1,0 +1,7 @@
+//! figurine host library: everything the `figurine` CLI does, usable from tests.
+//!
+//! Modules are named after their stage in the data flow (see DESIGN.md).
+
+pub mod data;
+pub mod events;
+pub mod poselog;

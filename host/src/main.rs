@@ -1,0 +1,28 @@
+//! The `figurine` command-line tool.
+
+use clap::{Parser, Subcommand};
+
+/// figurine: play with a toy, get a character animation.
+#[derive(Parser, Debug)]
+#[command(name = "figurine", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Subcommands; each lives in its own module of the library.
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print the wire-protocol version this host speaks.
+    ProtocolVersion,
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::ProtocolVersion => {
+            println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
+        }
+    }
+    Ok(())
+}

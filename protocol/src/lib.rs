@@ -1,0 +1,3 @@
+//! figurine wire protocol (work in progress in this commit).
+#![no_std]
+#![forbid(unsafe_code)]

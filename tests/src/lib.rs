@@ -1,0 +1,1 @@
+//! Helpers shared by figurine's end-to-end tests.

@@ -1,0 +1,2 @@
+//! `cargo xtask`: figurine's build automation (work in progress in this commit).
+fn main() {}
