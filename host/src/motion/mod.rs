@@ -13,12 +13,19 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+pub mod bvh_export;
 pub mod bvh_import;
 pub mod clip;
+pub mod deepmimic;
+pub mod gltf_export;
 pub mod skeleton;
+pub mod urdf;
 
+pub use bvh_export::{write_bvh_path, write_bvh_string};
 pub use bvh_import::{read_bvh, read_bvh_path, BvhImport};
 pub use clip::{slerp_short, Clip, Pose, WorldJoint};
+pub use deepmimic::{read_deepmimic_path, DeepMimicClip};
+pub use gltf_export::{write_glb_bytes, write_glb_path};
 pub use skeleton::{Axis, Channel, Joint, RotationOrder, Skeleton};
 
 /// Why motion data could not be read or written.

@@ -210,6 +210,23 @@ impl Skeleton {
         out
     }
 
+    /// Joint indices in depth-first order (the order a BVH file lists them), roots in order.
+    pub fn dfs_order(&self) -> Vec<usize> {
+        fn visit(sk: &Skeleton, j: usize, out: &mut Vec<usize>) {
+            out.push(j);
+            for k in sk.children(j) {
+                visit(sk, k, out);
+            }
+        }
+        let mut out = Vec::with_capacity(self.joints.len());
+        for (j, joint) in self.joints.iter().enumerate() {
+            if joint.parent.is_none() {
+                visit(self, j, &mut out);
+            }
+        }
+        out
+    }
+
     /// Rest-pose world positions of all joints (identity rotations, offsets only).
     pub fn rest_positions(&self) -> Vec<Vec3> {
         let mut out: Vec<Vec3> = Vec::with_capacity(self.joints.len());
