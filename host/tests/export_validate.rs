@@ -43,8 +43,20 @@ fn clips() -> Vec<(Clip, f32)> {
     out
 }
 
+/// The Python that `cargo xtask setup` prepared (a venv with `bvh`), else `python3`.
+fn python() -> PathBuf {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/tools/pyenv/bin/python");
+    std::env::var_os("FIGURINE_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or(if venv.exists() {
+            venv
+        } else {
+            PathBuf::from("python3")
+        })
+}
+
 fn python_has_bvh() -> bool {
-    Command::new("python3")
+    Command::new(python())
         .args(["-c", "import bvh"])
         .output()
         .map(|o| o.status.success())
@@ -70,7 +82,7 @@ first = [float(x) for x in m.frames[0]]
 print(json.dumps({"nframes": m.nframes, "frame_time": m.frame_time, "names": names,
                   "nvalues": len(first), "first": first}))
 "#;
-        let out = Command::new("python3")
+        let out = Command::new(python())
             .arg("-c")
             .arg(script)
             .arg(&path)
@@ -115,6 +127,7 @@ print(json.dumps({"nframes": m.nframes, "frame_time": m.frame_time, "names": nam
 fn validator_dir() -> Option<PathBuf> {
     let candidates = [
         std::env::var_os("GLTF_VALIDATOR_NODE_PATH").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/tools/node/node_modules")),
         Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/npm/node_modules")),
     ];
     candidates
