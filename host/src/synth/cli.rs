@@ -96,6 +96,21 @@ enum SynthCommand {
         #[command(flatten)]
         knobs: KnobArgs,
     },
+    /// One performance of every action (in the order walk, run, jump, punch, throw, kick,
+    /// turn, sidestep, crouch, bow, wave, spin), plotted small on a 4×3 grid.
+    Gallery {
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Effort of every performance (default: a random state each).
+        #[arg(long, default_value = "random")]
+        effort: EffortArg,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
     /// Draw a pose log as a PNG: top view, side view, speeds over time, label spans.
     Plot {
         /// The pose log (CSV).
@@ -322,6 +337,30 @@ pub fn run(args: SynthArgs) -> Result<()> {
                 write_doodle(d, &file)?;
                 summary(d, &file);
             }
+        }
+        SynthCommand::Gallery {
+            seed,
+            effort,
+            out,
+            knobs,
+        } => {
+            let knobs = knobs.knobs()?;
+            let pics: Vec<_> = Action::ALL
+                .iter()
+                .enumerate()
+                .map(|(i, &a)| {
+                    let s = super::sequence::item_seed(seed, i as u64);
+                    let e = effort
+                        .0
+                        .unwrap_or_else(|| super::sequence::random_state_for(s));
+                    let d = gesture(s, &knobs, a, e);
+                    super::plot::plot(&d.log, &d.labels)
+                })
+                .collect();
+            super::plot::gallery(&pics, 4)
+                .save(&out)
+                .with_context(|| format!("writing {}", out.display()))?;
+            println!("{}", out.display());
         }
         SynthCommand::Plot { log, labels, out } => {
             super::plot::plot_files(&log, labels.as_deref(), &out)?;

@@ -10,7 +10,9 @@
 //! * **Weight** sets the stroke's amplitude and its *ending*. Strong strokes are bigger
 //!   (×1.15–1.45), arrive with speed and stop abruptly with a short recoil (impact), so their
 //!   accelerations are large and concentrated; light strokes are smaller (×0.6–0.85) and fade out
-//!   delicately, with small, evenly spread accelerations.
+//!   delicately, with small, evenly spread accelerations. Following the Effort–Shape affinities
+//!   of seed 000 §5.1, strong hops are also relatively flatter (sinking) and light ones higher
+//!   (rising).
 //!
 //! The velocity profile of a stroke is a Beta-shaped bump `v(τ) ∝ τ^a (1−τ)^b` over normalised
 //! time τ ∈ [0, 1]: `a` (onset) comes from Time, `b` (ending) from Weight. Its integral, the
@@ -96,24 +98,32 @@ impl Effort {
         let amp = rng.unit();
         let ending = rng.unit();
         let ring = rng.unit();
+        let lift = rng.unit();
         let lerp = |lo: f64, hi: f64, u: f64| lo + (hi - lo) * u;
         let (time_factor, a) = match self.time {
             TimeClass::Sudden => (lerp(0.42, 0.7, tf), lerp(0.45, 0.9, onset)),
             TimeClass::Sustained => (lerp(1.5, 2.4, tf), lerp(1.7, 2.8, onset)),
             TimeClass::Neutral => (lerp(0.85, 1.2, tf), lerp(1.2, 1.9, onset)),
         };
-        let (amplitude, b, ring_amp) = match self.weight {
+        let (amplitude, b, ring_amp, lift) = match self.weight {
             WeightClass::Strong => (
                 lerp(1.15, 1.45, amp),
                 lerp(0.55, 1.0, ending),
                 lerp(0.06, 0.12, ring),
+                lerp(0.8, 0.95, lift),
             ),
-            WeightClass::Light => (lerp(0.6, 0.85, amp), lerp(2.2, 3.4, ending), 0.0),
-            WeightClass::Neutral => (lerp(0.9, 1.1, amp), lerp(1.2, 1.9, ending), 0.0),
+            WeightClass::Light => (
+                lerp(0.6, 0.85, amp),
+                lerp(2.2, 3.4, ending),
+                0.0,
+                lerp(1.1, 1.3, lift),
+            ),
+            WeightClass::Neutral => (lerp(0.9, 1.1, amp), lerp(1.2, 1.9, ending), 0.0, 1.0),
         };
         EffortShape {
             time_factor,
             amplitude,
+            lift,
             profile: Profile::new(a, b, ring_amp),
         }
     }
@@ -180,6 +190,9 @@ pub struct EffortShape {
     pub time_factor: f64,
     /// Multiplier of every stroke's translation amplitude (dimensionless).
     pub amplitude: f64,
+    /// Extra multiplier of upward arcs (hop heights): strong sinks (0.8–0.95), light rises
+    /// (1.1–1.3), after Bishko's Effort–Shape affinities cited in seed 000 §5.1.
+    pub lift: f64,
     /// Velocity profile of each stroke.
     pub profile: Profile,
 }

@@ -141,6 +141,14 @@ impl Draw<'_> {
         self.rng.uniform(lo_deg, hi_deg).to_radians()
     }
 
+    /// Where the fingers hold the toy when twisting it about the vertical: a horizontal offset
+    /// of 0–3 cm (× scale), so turns and spins also swing the tracked point a little.
+    fn grip(&mut self) -> DVec3 {
+        let r = self.rng.uniform(0.0, 0.03) * self.scale;
+        let a = self.rng.uniform(0.0, std::f64::consts::TAU);
+        DVec3::new(r * a.cos(), 0.0, r * a.sin())
+    }
+
     /// A main stroke (with the effort's impact recoil, if any).
     fn stroke(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
@@ -294,11 +302,13 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
         Action::Turn => {
             let angle = d.exact_ang(90.0, 180.0) * d.rng.sign();
             let pieces = if d.rng.chance(0.7) { 1 } else { 2 };
+            let grip = d.grip();
             for i in 0..pieces {
                 let mut s = d.stroke(0.45, 0.8);
                 s.duration *= if pieces == 2 { 0.6 } else { 1.0 };
                 s.rotate.y = angle / f64::from(pieces);
                 s.arc.y = d.len(0.008, 0.025);
+                s.pivot = grip;
                 out.push(s);
                 if i + 1 < pieces {
                     out.push(d.hold(0.03, 0.1));
@@ -336,41 +346,34 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
         }
         Action::Bow => {
             // The toy pivots about its feet, `r` below the tracked centre.
-            let r = d.len(0.03, 0.07);
+            let feet = DVec3::new(0.0, -d.len(0.03, 0.07), 0.0);
             let theta = d.ang(30.0, 70.0);
-            let offset = DVec3::new(0.0, -r * (1.0 - theta.cos()), r * theta.sin());
             let mut down = d.stroke(0.5, 0.8);
-            down.translate = offset;
             down.rotate.x = theta;
+            down.pivot = feet;
             out.push(down);
             out.push(d.hold(0.1, 0.5));
             let mut up = d.recover(0.5, 0.8);
-            up.translate = -offset;
             up.rotate.x = -theta;
+            up.pivot = feet;
             out.push(up);
         }
         Action::Wave => {
             let amp = d.ang(15.0, 30.0);
             let cycles = d.rng.int(2, 4);
             let first = d.rng.sign();
-            let r = d.len(0.02, 0.05);
-            // Roll targets: +A, −A, +A, … then back to 0.
+            let feet = DVec3::new(0.0, -d.len(0.02, 0.05), 0.0);
+            // Roll targets: +A, −A, +A, … then back to 0, rocking about the feet.
             let mut targets: Vec<f64> = (0..2 * cycles)
                 .map(|k| if k % 2 == 0 { amp } else { -amp } * first)
                 .collect();
             targets.push(0.0);
             let mut roll = 0.0_f64;
             for target in targets {
-                let scale_amp = d.rng.uniform(0.85, 1.15);
-                let target = target * scale_amp;
+                let target = target * d.rng.uniform(0.85, 1.15);
                 let mut s = d.stroke(0.14, 0.28);
                 s.rotate.z = target - roll;
-                // Positive roll tips the top toward −X about the feet pivot.
-                s.translate = DVec3::new(
-                    -r * (target.sin() - roll.sin()),
-                    r * (target.cos() - roll.cos()),
-                    0.0,
-                );
+                s.pivot = feet;
                 out.push(s);
                 roll = target;
             }
@@ -382,13 +385,37 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             } else {
                 d.len(0.005, 0.015)
             };
+            let grip = d.grip();
             let mut s = d.stroke(0.6, 1.1);
             s.rotate.y = angle;
             s.arc.y = hop;
+            s.pivot = grip;
             out.push(s);
         }
     }
+    sloppiness(action, &mut out, d.shape.lift, d.rng);
     out
+}
+
+/// Human imprecision: hop heights follow the effort's lift, every translation strays a little
+/// sideways (σ 6 % of its length, perpendicular to it), and hops along the floor wander in
+/// heading (σ 2°), so returns are not exact and paths are not ruler-straight.
+fn sloppiness(action: Action, strokes: &mut [Stroke], lift: f64, rng: &mut SynthRng) {
+    for s in strokes.iter_mut() {
+        if s.arc.y > 0.0 {
+            s.arc.y *= lift;
+        }
+        let len = s.translate.length();
+        let dev = DVec3::new(rng.normal(), 0.5 * rng.normal(), rng.normal()) * (0.06 * len);
+        let wander = rng.normal() * 2f64.to_radians();
+        if len > 0.0 {
+            let along = s.translate / len;
+            s.translate += dev - along * dev.dot(along);
+            if action.travels() {
+                s.rotate.y += wander;
+            }
+        }
+    }
 }
 
 #[cfg(test)]

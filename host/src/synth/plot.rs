@@ -6,7 +6,8 @@
 //! * top-right, **side view** (horizontal distance along the path's main direction → right,
 //!   height → up, equal aspect), same colours;
 //! * middle, **speeds** over time: linear speed (black, m/s) and angular speed (orange, rad/s),
-//!   each scaled to its own maximum, over label spans shaded by effort (sudden = warm, sustained
+//!   each scaled to its own maximum, light grey grid lines at a round step of linear speed
+//!   (1, 2 or 5 × 10^k m/s, about four lines), ticks every second, over label spans shaded by effort (sudden = warm, sustained
 //!   = cool; strong = dark, light = pale);
 //! * bottom, **orientation** over time relative to the first sample's heading: yaw (green,
 //!   unwrapped, full height = ±2.2π), pitch of the front (blue, front-down up) and roll
@@ -251,6 +252,22 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
     let lmax = lin.iter().cloned().fold(1e-9, f64::max);
     let amax = ang.iter().cloned().fold(1e-9, f64::max);
     let vy = |v: f64, m: f64| speed.y0 + speed.h - v / m * speed.h * 0.95;
+    // Grid: light lines at a round step of linear speed, ticks every second of log time.
+    let step = nice_step(lmax / 4.0);
+    let mut g = step;
+    while g < lmax {
+        let y = vy(g, lmax);
+        c.line((speed.x0, y), (speed.x0 + speed.w, y), Rgb([225, 225, 225]));
+        g += step;
+    }
+    let mut sec = t_lo.ceil();
+    while sec <= t_hi {
+        for p in [speed, orient] {
+            let x = tx(p, sec);
+            c.line((x, p.y0 + p.h - 8.0), (x, p.y0 + p.h), grey);
+        }
+        sec += 1.0;
+    }
     for i in 1..n {
         let (xa, xb) = (tx(speed, s[i - 1].t), tx(speed, s[i].t));
         c.line(
@@ -302,6 +319,34 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
         prev = Some((x, cur));
     }
     c.img
+}
+
+/// Tiles small copies of several plots into one picture, `cols` per row, in order.
+pub fn gallery(pictures: &[RgbImage], cols: u32) -> RgbImage {
+    let cols = cols.max(1);
+    let (cw, ch) = (WIDTH / 3, HEIGHT / 3);
+    let rows = (pictures.len() as u32).div_ceil(cols).max(1);
+    let mut out = RgbImage::from_pixel(cols * cw, rows * ch, Rgb([255, 255, 255]));
+    for (i, pic) in pictures.iter().enumerate() {
+        let small =
+            image::imageops::resize(pic, cw - 6, ch - 6, image::imageops::FilterType::Triangle);
+        let (x, y) = ((i as u32 % cols) * cw + 3, (i as u32 / cols) * ch + 3);
+        image::imageops::replace(&mut out, &small, i64::from(x), i64::from(y));
+    }
+    out
+}
+
+/// The round number (1, 2 or 5 × 10^k) nearest above `x`.
+fn nice_step(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return 1.0;
+    }
+    let p = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * p)
+        .find(|v| *v >= x)
+        .unwrap_or(10.0 * p)
 }
 
 /// Reads a pose log (and labels JSON), plots it, and writes the PNG.

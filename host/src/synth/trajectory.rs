@@ -29,6 +29,10 @@ pub struct Stroke {
     pub rotate: DVec3,
     /// Rotation bump `rot_arc·sin(π s)` as (pitch, yaw, roll), radians.
     pub rot_arc: DVec3,
+    /// Centre of the stroke's rotation relative to the tracked point, in the figurine's own
+    /// frame at the stroke's start, metres (zero: rotate about the tracked point). A bow pivots
+    /// about the feet below; a child spinning the toy in the fingers swings it about the grip.
+    pub pivot: DVec3,
     /// Progress over time.
     pub profile: Profile,
 }
@@ -47,12 +51,14 @@ impl Stroke {
             arc: DVec3::ZERO,
             rotate: DVec3::ZERO,
             rot_arc: DVec3::ZERO,
+            pivot: DVec3::ZERO,
             profile,
         }
     }
 
     /// `true` when the stroke moves nothing.
     pub fn is_hold(&self) -> bool {
+        // The pivot alone moves nothing: it only matters when something rotates.
         self.translate == DVec3::ZERO
             && self.arc == DVec3::ZERO
             && self.rotate == DVec3::ZERO
@@ -87,12 +93,21 @@ impl BodyState {
         let bump = (std::f64::consts::PI * s.clamp(-0.3, 1.3)).sin();
         let local = stroke.translate * s + stroke.arc * bump;
         let rot = stroke.rotate * s + stroke.rot_arc * bump;
-        Self {
+        let mut next = Self {
             pos: self.pos + DQuat::from_rotation_y(self.yaw) * local,
             pitch: self.pitch + rot.x,
             yaw: self.yaw + rot.y,
             roll: self.roll + rot.z,
+        };
+        if stroke.pivot != DVec3::ZERO {
+            // Rotating about c = p + q0·pivot moves the tracked point by
+            // q0·pivot − (q1·q0⁻¹)·(q0·pivot).
+            let q0 = self.quat(DQuat::IDENTITY);
+            let q1 = next.quat(DQuat::IDENTITY);
+            let arm = q0 * stroke.pivot;
+            next.pos += arm - (q1 * q0.inverse()) * arm;
         }
+        next
     }
 }
 
@@ -227,6 +242,30 @@ mod tests {
         assert!((q * DVec3::Z - DVec3::X).length() < 1e-9);
         assert_eq!(tr.state_at(0.0), origin());
         assert_eq!(tr.state_at(f64::NAN), origin());
+    }
+
+    #[test]
+    fn a_bow_pivots_about_the_feet() {
+        let r = 0.05;
+        let theta = 0.6_f64;
+        let mut tr = Trajectory::new(0.0, origin());
+        let mut down = Stroke::moving(1.0, Profile::smooth());
+        down.rotate.x = theta;
+        down.pivot = DVec3::new(0.0, -r, 0.0);
+        tr.push(down);
+        let mut up = down;
+        up.rotate.x = -theta;
+        tr.push(up);
+        let mid = tr.state_at(1.0);
+        let expect = origin().pos + DVec3::new(0.0, r * theta.cos() - r, r * theta.sin());
+        assert!((mid.pos - expect).length() < 1e-12, "{:?}", mid.pos);
+        assert!((tr.state_at(2.0).pos - origin().pos).length() < 1e-12);
+        // Feet stay put throughout.
+        for i in 0..=20 {
+            let st = tr.state_at(i as f64 * 0.1);
+            let feet = st.pos + st.quat(DQuat::IDENTITY) * DVec3::new(0.0, -r, 0.0);
+            assert!((feet - DVec3::new(1.0, 1.0 - r, 1.0)).length() < 1e-12);
+        }
     }
 
     #[test]
