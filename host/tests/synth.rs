@@ -42,17 +42,31 @@ fn extent(log: &PoseLog) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Speeds (m/s) and accelerations (m/s²) by finite differences over a clean, evenly sampled log.
+/// Radius of the toy's extremities (metres) for [`kinematics`]: a figurine is ~20 cm tall.
+const TOY_RADIUS_M: f64 = 0.1;
+
+/// Linear speeds (m/s) and peak-style accelerations (m/s²) of a clean, evenly sampled log by
+/// finite differences. The acceleration is that of the toy's extremities: |a| + r·|α|, so
+/// rotation gestures (turn, wave) count their angular impacts too.
 fn kinematics(log: &PoseLog) -> (Vec<f64>, Vec<f64>) {
     let s = &log.samples;
     let v: Vec<DVec3> = s
         .windows(2)
         .map(|w| (pos(&w[1]) - pos(&w[0])) / (w[1].t - w[0].t))
         .collect();
-    let a: Vec<f64> = v
+    let w: Vec<DVec3> = s
         .windows(2)
-        .zip(s.windows(3))
-        .map(|(vw, sw)| ((vw[1] - vw[0]) / ((sw[2].t - sw[0].t) / 2.0)).length())
+        .map(|p| {
+            let d = quat(&p[1]) * quat(&p[0]).inverse();
+            let d = if d.w < 0.0 { -d } else { d };
+            d.to_scaled_axis() / (p[1].t - p[0].t)
+        })
+        .collect();
+    let a: Vec<f64> = (1..v.len())
+        .map(|i| {
+            let dt = (s[i + 1].t - s[i - 1].t) / 2.0;
+            ((v[i] - v[i - 1]) / dt).length() + TOY_RADIUS_M * ((w[i] - w[i - 1]) / dt).length()
+        })
         .collect();
     (v.iter().map(|x| x.length()).collect(), a)
 }

@@ -149,17 +149,16 @@ impl Draw<'_> {
         DVec3::new(r * a.cos(), 0.0, r * a.sin())
     }
 
-    /// A main stroke (with the effort's impact recoil, if any).
+    /// A main stroke (with the effort's impact, if any).
     fn stroke(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
         Stroke::moving(d, self.shape.profile)
     }
 
-    /// A recovery stroke (same onset and ending, no recoil).
+    /// A recovery stroke (same onset and ending, no impact).
     fn recover(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
-        let p = self.shape.profile;
-        Stroke::moving(d, super::effort::Profile::new(p.a, p.b, 0.0))
+        Stroke::moving(d, self.shape.profile.without_impact())
     }
 }
 
