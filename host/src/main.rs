@@ -15,6 +15,8 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+    Synth(figurine_host::synth::cli::SynthArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -23,6 +25,7 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Synth(args) => figurine_host::synth::cli::run(args)?,
     }
     Ok(())
 }
