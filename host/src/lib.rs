@@ -4,5 +4,6 @@
 
 pub mod data;
 pub mod events;
+pub mod motion;
 pub mod poselog;
 pub mod render;
