@@ -15,6 +15,10 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
+    Render(figurine_host::render::cli::RenderArgs),
+    /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
+    View(figurine_host::render::cli::ViewArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -23,6 +27,8 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Render(args) => figurine_host::render::cli::run_render(&args)?,
+        Command::View(args) => figurine_host::render::cli::run_view(&args)?,
     }
     Ok(())
 }

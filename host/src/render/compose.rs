@@ -119,6 +119,15 @@ impl Composer {
         }
     }
 
+    /// A composer with given metrics and no doodle (live poses, where there is no clip to
+    /// measure in advance).
+    pub fn with_metrics(metrics: SceneMetrics) -> Self {
+        Composer {
+            metrics,
+            doodle: Vec::new(),
+        }
+    }
+
     /// The scene's measured size and ground.
     pub fn metrics(&self) -> SceneMetrics {
         self.metrics

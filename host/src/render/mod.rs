@@ -17,18 +17,18 @@
 //! - [`procedural`]: a procedural walking stick figure for tests, benchmarks and demos.
 
 pub mod camera;
-//pub mod cli;
+pub mod cli;
 pub mod compose;
-//pub mod from_clip;
+pub mod from_clip;
 pub mod gpu;
-//pub mod live;
+pub mod live;
 pub mod offscreen;
 pub mod overlay;
-//pub mod playback;
+pub mod playback;
 pub mod procedural;
 pub mod scene;
 pub mod video;
-//pub mod viewer;
+pub mod viewer;
 
 use std::path::PathBuf;
 
