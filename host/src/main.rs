@@ -17,6 +17,10 @@ enum Command {
     ProtocolVersion,
     /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
     Synth(figurine_host::synth::cli::SynthArgs),
+    /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
+    Render(figurine_host::render::cli::RenderArgs),
+    /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
+    View(figurine_host::render::cli::ViewArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -26,6 +30,8 @@ fn main() -> anyhow::Result<()> {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
         Command::Synth(args) => figurine_host::synth::cli::run(args)?,
+        Command::Render(args) => figurine_host::render::cli::run_render(&args)?,
+        Command::View(args) => figurine_host::render::cli::run_view(&args)?,
     }
     Ok(())
 }
