@@ -72,12 +72,12 @@ impl TwoSlotStore {
         let page = F::ERASE_SIZE as u64;
         let end = u64::from(self.base) + 2 * u64::from(self.slot_size);
         let ok = page > 0
-            && u64::from(self.base) % page == 0
-            && u64::from(self.slot_size) % page == 0
+            && u64::from(self.base).is_multiple_of(page)
+            && u64::from(self.slot_size).is_multiple_of(page)
             && self.slot_size as usize > HEADER_LEN
             && end <= flash.capacity() as u64
             && F::WRITE_SIZE <= MAX_WRITE_SIZE
-            && HEADER_LEN % F::WRITE_SIZE == 0
+            && HEADER_LEN.is_multiple_of(F::WRITE_SIZE)
             && F::READ_SIZE == 1;
         if ok {
             Ok(())
