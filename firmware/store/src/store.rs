@@ -91,6 +91,13 @@ impl TwoSlotStore {
         self.slot_size - HEADER_LEN as u32
     }
 
+    /// Flash offset of `blob`'s first byte, for boards whose flash is memory-mapped and read
+    /// in place. Those bytes never change while `blob` is the active one: uploads erase and
+    /// write only the other slot.
+    pub fn blob_offset(&self, blob: &ActiveBlob) -> u32 {
+        self.slot_addr(blob.slot) + HEADER_LEN as u32
+    }
+
     fn slot_addr(&self, slot: u8) -> u32 {
         self.base + u32::from(slot) * self.slot_size
     }
