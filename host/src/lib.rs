@@ -4,4 +4,5 @@
 
 pub mod data;
 pub mod events;
+pub mod link;
 pub mod poselog;
