@@ -24,9 +24,10 @@ use defmt_semihosting as _;
 async fn main(spawner: embassy_executor::Spawner) {
     let board = board::init();
     defmt::info!(
-        "figurine firmware {} on {}, build {=u32:08x}",
+        "figurine firmware {} on {} ({} Hz), build {=u32:08x}",
         env!("CARGO_PKG_VERSION"),
         board::NAME,
+        board::CORE_HZ,
         engine::BUILD_ID
     );
     spawner.spawn(link_rx::task(board.rx).expect("link_rx spawned once"));
