@@ -5,3 +5,4 @@
 pub mod data;
 pub mod events;
 pub mod poselog;
+pub mod recognize;

@@ -15,6 +15,12 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Learn (or replace) an action's pattern from example pose logs.
+    Learn(figurine_host::recognize::learn::LearnArgs),
+    /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
+    TrainEffort(figurine_host::recognize::effort_train::TrainEffortArgs),
+    /// Run the recognizer on a pose log and print the recognised actions.
+    Simulate(figurine_host::recognize::simulate::SimulateArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -23,6 +29,9 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Learn(a) => figurine_host::recognize::learn::run(&a)?,
+        Command::TrainEffort(a) => figurine_host::recognize::effort_train::run(&a)?,
+        Command::Simulate(a) => figurine_host::recognize::simulate::run(&a)?,
     }
     Ok(())
 }
