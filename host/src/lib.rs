@@ -6,3 +6,4 @@ pub mod data;
 pub mod events;
 pub mod poselog;
 pub mod recognize;
+pub mod synth;

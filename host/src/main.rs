@@ -21,6 +21,8 @@ enum Command {
     TrainEffort(figurine_host::recognize::effort_train::TrainEffortArgs),
     /// Run the recognizer on a pose log and print the recognised actions.
     Simulate(figurine_host::recognize::simulate::SimulateArgs),
+    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+    Synth(figurine_host::synth::cli::SynthArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -32,6 +34,7 @@ fn main() -> anyhow::Result<()> {
         Command::Learn(a) => figurine_host::recognize::learn::run(&a)?,
         Command::TrainEffort(a) => figurine_host::recognize::effort_train::run(&a)?,
         Command::Simulate(a) => figurine_host::recognize::simulate::run(&a)?,
+        Command::Synth(args) => figurine_host::synth::cli::run(args)?,
     }
     Ok(())
 }
