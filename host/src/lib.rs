@@ -6,3 +6,5 @@ pub mod data;
 pub mod events;
 pub mod link;
 pub mod poselog;
+pub mod recognize;
+pub mod synth;

@@ -44,7 +44,10 @@ fn handshake_ping_and_stats() {
     // Counted since the reset: 5 pings, 20 poses, a ping, GetStats — plus the ping that
     // followed the reset if the receiver counted it after the engine cleared the counters.
     assert!((27..=28).contains(&s.frames_ok), "{s:?}");
-    assert_eq!(s.crc_errors + s.cobs_errors + s.decode_errors + s.oversize, 0);
+    assert_eq!(
+        s.crc_errors + s.cobs_errors + s.decode_errors + s.oversize,
+        0
+    );
 }
 
 #[test]
@@ -74,7 +77,8 @@ fn uploads_are_acknowledged_checked_and_refused_with_reasons() {
     .unwrap();
     dev.send(&chunk(4)).unwrap();
     dev.send(&chunk(0)).unwrap();
-    dev.send(&HostToDevice::UploadCommit(BlobKind::Library)).unwrap();
+    dev.send(&HostToDevice::UploadCommit(BlobKind::Library))
+        .unwrap();
     dev.ping().unwrap();
     let mut codes = Vec::new();
     while let Some(m) = dev.poll(std::time::Duration::ZERO).unwrap() {
@@ -84,10 +88,16 @@ fn uploads_are_acknowledged_checked_and_refused_with_reasons() {
     }
     assert_eq!(
         codes,
-        [ErrorCode::UploadNotStarted, ErrorCode::UploadOutOfOrder, ErrorCode::UploadCrc]
+        [
+            ErrorCode::UploadNotStarted,
+            ErrorCode::UploadOutOfOrder,
+            ErrorCode::UploadCrc
+        ]
     );
     // A valid one is stored and survives a reconnect.
-    let crc = dev.upload(BlobKind::Library, &EMPTY_LIBRARY, |_, _| {}).unwrap();
+    let crc = dev
+        .upload(BlobKind::Library, &EMPTY_LIBRARY, |_, _| {})
+        .unwrap();
     drop(dev);
     let dev = q.connect().unwrap();
     assert_eq!(dev.hello().library_crc, crc);
@@ -149,7 +159,9 @@ fn garbage_and_truncated_frames_are_counted_and_every_valid_frame_after_them_is_
             }
             2 => {
                 // More non-zero bytes than any frame: one oversize report.
-                let junk: Vec<u8> = (0..MAX_FRAME_LEN + 50).map(|_| (next() as u8) | 1).collect();
+                let junk: Vec<u8> = (0..MAX_FRAME_LEN + 50)
+                    .map(|_| (next() as u8) | 1)
+                    .collect();
                 dev.send_raw(&junk).unwrap();
                 oversize += 1;
             }

@@ -101,7 +101,10 @@ pub fn devices(args: &DevicesArgs) -> Result<()> {
 
 /// Uploads both blobs to a connected device, skipping any it already runs.
 pub fn upload_to(dev: &mut Device, blobs: &Blobs, quiet: bool) -> Result<()> {
-    for (kind, blob) in [(BlobKind::Library, &blobs.library), (BlobKind::Effort, &blobs.effort)] {
+    for (kind, blob) in [
+        (BlobKind::Library, &blobs.library),
+        (BlobKind::Effort, &blobs.effort),
+    ] {
         let have = match kind {
             BlobKind::Library => dev.hello().library_crc,
             BlobKind::Effort => dev.hello().effort_crc,
@@ -153,11 +156,17 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut write_err = None;
-    let r = replay_log(&mut dev, &log, &blobs.names, ReplayOptions { speed: args.speed }, |rec| {
-        if let Err(e) = write_event(&mut out, rec).and_then(|()| out.flush()) {
-            write_err.get_or_insert(e);
-        }
-    })
+    let r = replay_log(
+        &mut dev,
+        &log,
+        &blobs.names,
+        ReplayOptions { speed: args.speed },
+        |rec| {
+            if let Err(e) = write_event(&mut out, rec).and_then(|()| out.flush()) {
+                write_err.get_or_insert(e);
+            }
+        },
+    )
     .with_context(|| format!("replaying {}", args.log.display()))?;
     if let Some(e) = write_err {
         return Err(e.into());
@@ -166,7 +175,10 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         eprintln!("{:#?}", r.stats);
     }
     if r.unsendable > 0 {
-        eprintln!("{} log samples could not be sent (NaN, out of range)", r.unsendable);
+        eprintln!(
+            "{} log samples could not be sent (NaN, out of range)",
+            r.unsendable
+        );
     }
     Ok(())
 }

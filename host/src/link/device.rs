@@ -234,11 +234,14 @@ impl Device {
         let wait = deadline.saturating_duration_since(Instant::now());
         match self.rx.recv_timeout(wait) {
             Ok(Incoming::Msg(m)) => Ok(self.accept(m)),
-            Ok(Incoming::Closed(why)) => Err(LinkError::Disconnected(format!("{}: {why}", self.spec))),
-            Err(RecvTimeoutError::Timeout) => Err(LinkError::Timeout(self.spec.to_string())),
-            Err(RecvTimeoutError::Disconnected) => {
-                Err(LinkError::Disconnected(format!("{}: reader stopped", self.spec)))
+            Ok(Incoming::Closed(why)) => {
+                Err(LinkError::Disconnected(format!("{}: {why}", self.spec)))
             }
+            Err(RecvTimeoutError::Timeout) => Err(LinkError::Timeout(self.spec.to_string())),
+            Err(RecvTimeoutError::Disconnected) => Err(LinkError::Disconnected(format!(
+                "{}: reader stopped",
+                self.spec
+            ))),
         }
     }
 
@@ -371,14 +374,21 @@ impl Device {
         }
         let ack = |want: u32| {
             move |m: &DeviceToHost| match m {
-                DeviceToHost::UploadAck { kind: k, next_offset } if *k == kind && *next_offset == want => Some(()),
+                DeviceToHost::UploadAck {
+                    kind: k,
+                    next_offset,
+                } if *k == kind && *next_offset == want => Some(()),
                 _ => None,
             }
         };
-        self.request(&HostToDevice::UploadBegin(UploadBegin { kind, len, crc32 }), ack(0))?;
+        self.request(
+            &HostToDevice::UploadBegin(UploadBegin { kind, len, crc32 }),
+            ack(0),
+        )?;
         let mut offset = 0usize;
         for piece in blob.chunks(MAX_CHUNK_LEN) {
-            let data = heapless::Vec::from_slice(piece).map_err(|_| LinkError::TooLarge(piece.len()))?;
+            let data =
+                heapless::Vec::from_slice(piece).map_err(|_| LinkError::TooLarge(piece.len()))?;
             let next = (offset + piece.len()) as u32;
             self.request(
                 &HostToDevice::UploadChunk(UploadChunk {

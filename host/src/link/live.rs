@@ -74,7 +74,10 @@ fn record_path(base: &Path, n: usize) -> PathBuf {
     if n == 0 {
         return base.to_path_buf();
     }
-    let stem = base.file_stem().and_then(|s| s.to_str()).unwrap_or("session");
+    let stem = base
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("session");
     let ext = base.extension().and_then(|s| s.to_str()).unwrap_or("csv");
     base.with_file_name(format!("{stem}-{}.{ext}", n + 1))
 }
@@ -100,7 +103,11 @@ impl Session<'_> {
         }
         match Device::connect(&self.spec) {
             Ok(d) => {
-                eprintln!("{}: connected (library {:08x})", self.label, d.hello().library_crc);
+                eprintln!(
+                    "{}: connected (library {:08x})",
+                    self.label,
+                    d.hello().library_crc
+                );
                 self.dev = Some(d);
             }
             Err(e) => {
@@ -111,7 +118,10 @@ impl Session<'_> {
     }
 
     fn lost(&mut self, e: &dyn std::fmt::Display) {
-        eprintln!("{}: {e}; reconnecting (poses are still recorded)", self.label);
+        eprintln!(
+            "{}: {e}; reconnecting (poses are still recorded)",
+            self.label
+        );
         self.dev = None;
         self.next_retry = Instant::now() + RECONNECT_EVERY;
     }
@@ -184,19 +194,32 @@ impl Session<'_> {
     }
 }
 
-fn run_session(
+/// One figurine's part of a `live` run.
+struct Plan {
     spec: PortSpec,
-    label: String,
     source: Option<PathBuf>,
     speed: f64,
     record: Option<PathBuf>,
+}
+
+fn run_session(
+    plan: Plan,
     names: &[String],
     print: &Mutex<std::io::Stdout>,
     many: bool,
 ) -> Result<()> {
+    let Plan {
+        spec,
+        source,
+        speed,
+        record,
+    } = plan;
+    let label = spec.to_string();
     let record = match record {
         Some(p) => {
-            let mut w = BufWriter::new(File::create(&p).with_context(|| format!("creating {}", p.display()))?);
+            let mut w = BufWriter::new(
+                File::create(&p).with_context(|| format!("creating {}", p.display()))?,
+            );
             writeln!(w, "t,x,y,z,qw,qx,qy,qz")?;
             w.flush()?;
             Some(w)
@@ -267,16 +290,22 @@ pub fn live(args: &LiveArgs) -> Result<()> {
             .into_iter()
             .enumerate()
             .map(|(n, spec)| {
-                let label = spec.to_string();
-                let source = args.logs.get(n).cloned();
-                let record = args.record.as_deref().map(|r| record_path(r, n));
+                let plan = Plan {
+                    spec,
+                    source: args.logs.get(n).cloned(),
+                    speed: args.speed,
+                    record: args.record.as_deref().map(|r| record_path(r, n)),
+                };
                 let (names, print) = (&names, &print);
-                scope.spawn(move || run_session(spec, label, source, args.speed, record, names, print, many))
+                scope.spawn(move || run_session(plan, names, print, many))
             })
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| bail!("a session thread panicked")))
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| bail!("a session thread panicked"))
+            })
             .collect::<Result<Vec<()>>>()
     })?;
     Ok(())
@@ -299,7 +328,13 @@ mod tests {
 
     #[test]
     fn record_paths_number_extra_figurines() {
-        assert_eq!(record_path(Path::new("/tmp/s.csv"), 0), PathBuf::from("/tmp/s.csv"));
-        assert_eq!(record_path(Path::new("/tmp/s.csv"), 1), PathBuf::from("/tmp/s-2.csv"));
+        assert_eq!(
+            record_path(Path::new("/tmp/s.csv"), 0),
+            PathBuf::from("/tmp/s.csv")
+        );
+        assert_eq!(
+            record_path(Path::new("/tmp/s.csv"), 1),
+            PathBuf::from("/tmp/s-2.csv")
+        );
     }
 }

@@ -3,12 +3,9 @@
 //! replay through a device with the same JSON-lines output as `figurine simulate`, live
 //! sessions that survive unplugging, and the `devices`/`upload`/`replay`/`live` subcommands.
 
-#[cfg(any())]
 pub mod blobs;
-#[cfg(any())]
 pub mod cli;
 pub mod device;
-#[cfg(any())]
 pub mod live;
 pub mod replay;
 pub mod transport;

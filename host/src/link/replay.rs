@@ -50,7 +50,12 @@ pub fn event_indices(e: &ActionEvent, last_sent: usize) -> (usize, usize) {
 }
 
 /// The JSON-lines record of a device event (names from the library, times from the log).
-pub fn to_record(e: &ActionEvent, names: &[String], log: &PoseLog, last_sent: usize) -> ActionRecord {
+pub fn to_record(
+    e: &ActionEvent,
+    names: &[String],
+    log: &PoseLog,
+    last_sent: usize,
+) -> ActionRecord {
     let (start, end) = event_indices(e, last_sent);
     let t = |i: usize| log.samples.get(i).map_or(f64::NAN, |s| s.t);
     ActionRecord {
@@ -86,16 +91,17 @@ pub fn replay_log(
         unsendable: 0,
     };
     let mut last_sent = 0usize;
-    let mut collect = |dev: &mut Device, out: &mut Replay, last_sent: usize| -> Result<(), LinkError> {
-        let now = Instant::now();
-        for e in dev.take_events()? {
-            let rec = to_record(&e, names, log, last_sent);
-            on_event(&rec);
-            out.records.push(rec);
-            out.events.push((e, now));
-        }
-        Ok(())
-    };
+    let mut collect =
+        |dev: &mut Device, out: &mut Replay, last_sent: usize| -> Result<(), LinkError> {
+            let now = Instant::now();
+            for e in dev.take_events()? {
+                let rec = to_record(&e, names, log, last_sent);
+                on_event(&rec);
+                out.records.push(rec);
+                out.events.push((e, now));
+            }
+            Ok(())
+        };
     let t0 = log.samples.first().map_or(0.0, |s| s.t);
     let start = Instant::now();
     let mut in_flight = std::collections::VecDeque::new();

@@ -30,7 +30,11 @@ impl FromStr for PortSpec {
 
     fn from_str(s: &str) -> Result<Self, LinkError> {
         match s.strip_prefix("tcp:") {
-            Some(addr) if addr.rsplit_once(':').is_some_and(|(h, p)| !h.is_empty() && p.parse::<u16>().is_ok()) => {
+            Some(addr)
+                if addr
+                    .rsplit_once(':')
+                    .is_some_and(|(h, p)| !h.is_empty() && p.parse::<u16>().is_ok()) =>
+            {
                 Ok(PortSpec::Tcp(addr.to_string()))
             }
             Some(_) => Err(LinkError::BadPort(s.to_string())),
