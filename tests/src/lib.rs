@@ -2,6 +2,7 @@
 //! instance running it (reaped by a Drop guard, also when a test fails), and a connected
 //! host-side [`figurine_host::link::Device`].
 
+pub mod pose6d;
 pub mod qemu;
 
 pub use qemu::{firmware_elf, Qemu, QemuOptions};

@@ -34,8 +34,19 @@ pub fn firmware_elf() -> Result<PathBuf> {
             path.display()
         );
     }
+    let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    if !bytes.windows(BOARD_TAG.len()).any(|w| w == BOARD_TAG) {
+        bail!(
+            "{} is not a QEMU build of the firmware (another board?): rebuild it with \
+             `cargo xtask firmware --board qemu`",
+            path.display()
+        );
+    }
     Ok(path)
 }
+
+/// Marker the QEMU board puts into its ELF.
+const BOARD_TAG: &[u8] = b"figurine-board:qemu-mps2-an386";
 
 /// How to start the emulator.
 #[derive(Debug, Clone, Default)]

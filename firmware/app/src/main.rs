@@ -13,6 +13,7 @@ mod blobs;
 mod board;
 mod channels;
 mod engine;
+mod executor;
 mod link_rx;
 mod link_tx;
 mod stats;
@@ -20,8 +21,8 @@ mod stats;
 #[cfg(feature = "qemu")]
 use defmt_semihosting as _;
 
-#[embassy_executor::main]
-async fn main(spawner: embassy_executor::Spawner) {
+#[cortex_m_rt::entry]
+fn main() -> ! {
     let board = board::init();
     defmt::info!(
         "figurine firmware {} on {} ({} Hz), build {=u32:08x}",
@@ -30,7 +31,9 @@ async fn main(spawner: embassy_executor::Spawner) {
         board::CORE_HZ,
         engine::BUILD_ID
     );
-    spawner.spawn(link_rx::task(board.rx).expect("link_rx spawned once"));
-    spawner.spawn(engine::task(board.flash).expect("engine spawned once"));
-    spawner.spawn(link_tx::task(board.tx).expect("link_tx spawned once"));
+    executor::run(|spawner| {
+        spawner.spawn(link_rx::task(board.rx).expect("link_rx spawned once"));
+        spawner.spawn(engine::task(board.flash).expect("engine spawned once"));
+        spawner.spawn(link_tx::task(board.tx).expect("link_tx spawned once"));
+    })
 }

@@ -322,6 +322,15 @@ impl Device {
     /// Waits for `Pong(v)`; everything the device sent before it goes to the backlog.
     /// Since the device answers in order, every message sent before `Ping(v)` was handled.
     pub fn wait_pong(&mut self, v: u32) -> Result<(), LinkError> {
+        // `take_events` may already have moved it into the backlog.
+        if let Some(i) = self
+            .backlog
+            .iter()
+            .position(|m| matches!(m, DeviceToHost::Pong(p) if *p == v))
+        {
+            self.backlog.remove(i);
+            return Ok(());
+        }
         let deadline = Instant::now() + REPLY_TIMEOUT;
         loop {
             match self.recv_until(deadline)? {

@@ -21,6 +21,10 @@ use super::Board;
 
 /// Board name (part of the build id).
 pub const NAME: &str = "qemu-mps2-an386";
+/// Marks the ELF as built for this board, so the e2e tests refuse a binary for another one.
+#[used]
+static BOARD_TAG: [u8; 30] = *b"figurine-board:qemu-mps2-an386";
+
 /// Core and SysTick clock, Hz.
 pub const CORE_HZ: u32 = 25_000_000;
 /// SysTick reload: the full 24 bits, so one wrap is 0.67 s (the stopwatch's range).
@@ -87,6 +91,18 @@ pub fn init() -> Board {
         tx,
         flash: Flash::new(cut),
     }
+}
+
+#[cortex_m_rt::exception]
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::error!("hard fault at pc {=u32:08x}", frame.pc());
+    semihosting::process::exit(103)
+}
+
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irq: i16) {
+    defmt::error!("unexpected exception/interrupt {}", irq);
+    semihosting::process::exit(104)
 }
 
 #[panic_handler]
