@@ -21,6 +21,10 @@ enum Command {
     TrainEffort(figurine_host::recognize::effort_train::TrainEffortArgs),
     /// Run the recognizer on a pose log and print the recognised actions.
     Simulate(figurine_host::recognize::simulate::SimulateArgs),
+    /// Print the motion-token runs of a pose log (what patterns are written in).
+    Tokens(figurine_host::recognize::tokens::TokensArgs),
+    /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9).
+    Eval(figurine_host::recognize::eval::EvalArgs),
     /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
     Synth(figurine_host::synth::cli::SynthArgs),
     /// List serial ports (and, with --probe, the figurines on them).
@@ -42,6 +46,8 @@ fn main() -> anyhow::Result<()> {
         Command::Learn(a) => figurine_host::recognize::learn::run(&a)?,
         Command::TrainEffort(a) => figurine_host::recognize::effort_train::run(&a)?,
         Command::Simulate(a) => figurine_host::recognize::simulate::run(&a)?,
+        Command::Tokens(a) => figurine_host::recognize::tokens::run(&a)?,
+        Command::Eval(a) => figurine_host::recognize::eval::run(&a)?,
         Command::Synth(args) => figurine_host::synth::cli::run(args)?,
         Command::Devices(a) => figurine_host::link::cli::devices(&a)?,
         Command::Upload(a) => figurine_host::link::cli::upload(&a)?,

@@ -35,7 +35,9 @@ pub struct ActionEvent {
     pub weight_q: i8,
     /// Edit distance of the match.
     pub distance: u8,
-    /// Time of the sample at which the decision was taken, µs (latency = this − `end_us`).
+    /// Sequence number of the sample at which the decision was taken.
+    pub decided_seq: u32,
+    /// Time of that sample, µs (decision latency = this − `end_us`).
     pub decided_us: u64,
 }
 
@@ -64,6 +66,7 @@ pub struct Recognizer<'lib> {
     tokens: u32,
     events: u32,
     now_us: u64,
+    now_seq: u32,
 }
 
 impl<'lib> Recognizer<'lib> {
@@ -79,6 +82,7 @@ impl<'lib> Recognizer<'lib> {
             tokens: 0,
             events: 0,
             now_us: 0,
+            now_seq: 0,
         }
     }
 
@@ -116,6 +120,7 @@ impl<'lib> Recognizer<'lib> {
     /// Feeds one sample; `emit` receives each action committed by it (in time order).
     pub fn push(&mut self, s: &Sample, mut emit: impl FnMut(ActionEvent)) {
         self.now_us = s.t_us;
+        self.now_seq = s.seq;
         let mut opened: [Option<(u32, Token)>; 8] = [None; 8];
         let mut n_opened = 0usize;
         let mut gap = false;
@@ -259,6 +264,7 @@ impl<'lib> Recognizer<'lib> {
                 time_q: quantise(lt),
                 weight_q: quantise(lw),
                 distance: c.distance,
+                decided_seq: self.now_seq,
                 decided_us: self.now_us,
             });
             self.events = self.events.saturating_add(1);

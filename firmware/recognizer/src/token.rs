@@ -40,9 +40,9 @@ pub const DOM_ON: f32 = 0.45;
 /// Component share below which an active sign switches off.
 pub const DOM_OFF: f32 = 0.30;
 /// Translation noise floor, m/s.
-pub const V_FLOOR_M_S: f32 = 0.03;
-/// Rotation noise floor, rad/s (≈ 29 °/s).
-pub const W_FLOOR_RAD_S: f32 = 0.5;
+pub const V_FLOOR_M_S: f32 = 0.07;
+/// Rotation noise floor, rad/s (≈ 34 °/s).
+pub const W_FLOOR_RAD_S: f32 = 0.6;
 /// Share of the recent peak below which a vector is inactive.
 pub const REL_ACTIVE: f32 = 0.10;
 /// Time constant of the decaying peak, seconds.

@@ -11,6 +11,7 @@
 pub mod dtw;
 pub mod effort_model;
 pub mod effort_train;
+pub mod eval;
 pub mod feed;
 pub mod font;
 pub mod learn;
@@ -18,3 +19,4 @@ pub mod library;
 pub mod regex;
 pub mod report;
 pub mod simulate;
+pub mod tokens;
