@@ -5,6 +5,8 @@
 pub mod data;
 pub mod events;
 pub mod motion;
+pub mod link;
 pub mod poselog;
+pub mod recognize;
 pub mod synth;
 pub mod render;
