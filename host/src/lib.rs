@@ -4,9 +4,9 @@
 
 pub mod data;
 pub mod events;
-pub mod motion;
 pub mod link;
+pub mod motion;
 pub mod poselog;
 pub mod recognize;
-pub mod synth;
 pub mod render;
+pub mod synth;

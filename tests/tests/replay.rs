@@ -61,9 +61,17 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
     let knobs = Knobs::default();
     for seed in [1u64, 2, 3] {
         let doodle = sequence(seed, &knobs, 4, None);
-        events += check_identical(&mut dev, &blobs, &doodle.log, &format!("synthetic seed {seed}"));
+        events += check_identical(
+            &mut dev,
+            &blobs,
+            &doodle.log,
+            &format!("synthetic seed {seed}"),
+        );
     }
-    assert!(events > 0, "the synthetic sequences produced no events at all");
+    assert!(
+        events > 0,
+        "the synthetic sequences produced no events at all"
+    );
 
     for name in ["tum_fr1_xyz_groundtruth.txt", "euroc_v102_groundtruth.csv"] {
         let Some(path) = data_file("pose6d", name) else {
