@@ -37,4 +37,4 @@ pub mod trajectory;
 pub use effort::{Effort, TimeClass, WeightClass};
 pub use gesture::Action;
 pub use knobs::{Knobs, Range, Variation};
-pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label};
+pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label, Performer};
