@@ -389,7 +389,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
                         .0
                         .unwrap_or_else(|| super::sequence::random_state_for(s));
                     let d = gesture(s, &knobs, a, e);
-                    super::plot::plot(&d.log, &d.labels)
+                    (super::plot::plot(&d.log, &d.labels), format!("{a} {e}"))
                 })
                 .collect();
             super::plot::gallery(&pics, 4)

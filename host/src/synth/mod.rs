@@ -25,6 +25,7 @@
 
 pub mod cli;
 pub mod effort;
+pub mod font;
 pub mod gesture;
 pub mod knobs;
 pub mod noise;
