@@ -476,3 +476,104 @@ fn long_sequences_stay_in_the_room() {
     assert!(far < 6.0, "wandered {far} m from the centre");
     assert_eq!(d.labels.len(), 300);
 }
+
+/// Unwrapped heading change (radians) of the figurine's front over a log.
+fn total_yaw(log: &PoseLog) -> f64 {
+    let mut total = 0.0;
+    let mut prev: Option<f64> = None;
+    for s in &log.samples {
+        let f = quat(s) * DVec3::Z;
+        let yaw = f.x.atan2(f.z);
+        if let Some(p) = prev {
+            let d = (yaw - p + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            total += d;
+        }
+        prev = Some(yaw);
+    }
+    total
+}
+
+#[test]
+fn actions_move_the_way_the_conventions_say() {
+    // Object frame: +Z front, +Y up, +X left; quaternion maps object to world.
+    let k = Knobs {
+        heading_deg: Range::fixed(37.0),
+        ..Knobs::canonical()
+    };
+    for seed in 0..5 {
+        let run = |a: Action| gesture(seed, &k, a, Effort::NEUTRAL).log;
+        let first = |l: &PoseLog| l.samples[0];
+        let last = |l: &PoseLog| *l.samples.last().unwrap();
+
+        let walk = run(Action::Walk);
+        let front = quat(&first(&walk)) * DVec3::Z;
+        let moved = pos(&last(&walk)) - pos(&first(&walk));
+        assert!(moved.normalize().dot(front) > 0.9, "walk goes forward");
+        assert!(walk
+            .samples
+            .iter()
+            .any(|s| s.pos[1] > walk.samples[0].pos[1] + 0.01));
+
+        let side = run(Action::Sidestep);
+        let left = quat(&first(&side)) * DVec3::X;
+        let moved = pos(&last(&side)) - pos(&first(&side));
+        assert!(
+            moved.normalize().dot(left).abs() > 0.9,
+            "sidestep goes sideways"
+        );
+
+        let jump = run(Action::Jump);
+        let y0 = jump.samples[0].pos[1];
+        let top = jump
+            .samples
+            .iter()
+            .map(|s| s.pos[1])
+            .fold(f64::MIN, f64::max);
+        assert!(top - y0 > 0.1, "jump rises {}", top - y0);
+
+        let crouch = run(Action::Crouch);
+        let low = crouch
+            .samples
+            .iter()
+            .map(|s| s.pos[1])
+            .fold(f64::MAX, f64::min);
+        assert!(crouch.samples[0].pos[1] - low > 0.03, "crouch sinks");
+
+        let bow = run(Action::Bow);
+        let deepest = bow
+            .samples
+            .iter()
+            .map(|s| (quat(s) * DVec3::Z).y)
+            .fold(f64::MAX, f64::min);
+        assert!(deepest < -0.4, "bow tips the front down: {deepest}");
+
+        let turn = total_yaw(&run(Action::Turn)).abs().to_degrees();
+        assert!((85.0..=185.0).contains(&turn), "turn {turn}°");
+        let spin = total_yaw(&run(Action::Spin)).abs().to_degrees();
+        assert!((315.0..=405.0).contains(&spin), "spin {spin}°");
+
+        let wave = run(Action::Wave);
+        let rolls: Vec<f64> = wave
+            .samples
+            .iter()
+            .map(|s| (quat(s) * DVec3::Y).dot(quat(&wave.samples[0]) * DVec3::X))
+            .collect();
+        let swings = rolls
+            .windows(2)
+            .filter(|w| (w[0] > 0.05 && w[1] <= 0.05) || (w[0] < -0.05 && w[1] >= -0.05))
+            .count();
+        assert!(swings >= 4, "wave swings {swings}");
+        let drift = (pos(&last(&wave)) - pos(&first(&wave))).length();
+        assert!(drift < 0.01, "wave stays put: {drift}");
+
+        let punch = run(Action::Punch);
+        let front = quat(&first(&punch)) * DVec3::Z;
+        let reach = punch
+            .samples
+            .iter()
+            .map(|s| (pos(s) - pos(&punch.samples[0])).dot(front))
+            .fold(f64::MIN, f64::max);
+        assert!(reach > 0.08, "punch reaches forward {reach}");
+    }
+}
