@@ -577,3 +577,75 @@ fn actions_move_the_way_the_conventions_say() {
         assert!(reach > 0.08, "punch reaches forward {reach}");
     }
 }
+
+/// Speed of a log smoothed by central differences over ±`h` seconds, m/s, with sample times.
+fn smoothed_speed(s: &[PoseSample], h: f64) -> Vec<f64> {
+    let n = s.len();
+    (0..n)
+        .map(|i| {
+            let j = (0..=i).rev().find(|&j| s[i].t - s[j].t >= h).unwrap_or(0);
+            let k = (i..n).find(|&k| s[k].t - s[i].t >= h).unwrap_or(n - 1);
+            if s[k].t > s[j].t {
+                (pos(&s[k]) - pos(&s[j])).length() / (s[k].t - s[j].t)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Best accuracy of a single threshold on `x` separating `y`, either direction.
+fn threshold_accuracy(mut xy: Vec<(f64, bool)>) -> f64 {
+    xy.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let n = xy.len();
+    let positives = xy.iter().filter(|p| p.1).count();
+    let mut best = 0;
+    let mut pos_below = 0;
+    for i in 0..=n {
+        if i > 0 && xy[i - 1].1 {
+            pos_below += 1;
+        }
+        let right = (i - pos_below) + (positives - pos_below);
+        best = best.max(right.max(n - right));
+    }
+    best as f64 / n as f64
+}
+
+#[test]
+fn effort_classes_are_learnable_from_scale_free_cues() {
+    // Default (wide, noisy) knobs, pooled over all actions: Time shows in the duration, Weight
+    // in how abruptly strokes stop compared with how they start (peak deceleration over peak
+    // acceleration of the smoothed speed). One threshold per cue must already separate them.
+    let set = effort_set(99, &Knobs::default(), 30);
+    let mut time = Vec::new();
+    let mut weight = Vec::new();
+    for (e, d) in &set {
+        let l = &d.labels[0];
+        let s: Vec<PoseSample> = d
+            .log
+            .samples
+            .iter()
+            .filter(|s| s.t >= l.start - 0.1 && s.t <= l.end + 0.1)
+            .copied()
+            .collect();
+        let h = 0.015;
+        let v = smoothed_speed(&s, h);
+        let (mut up, mut down) = (0.0f64, 0.0f64);
+        let n = s.len();
+        for i in 0..n {
+            let j = (0..=i).rev().find(|&j| s[i].t - s[j].t >= h).unwrap_or(0);
+            let k = (i..n).find(|&k| s[k].t - s[i].t >= h).unwrap_or(n - 1);
+            if s[k].t > s[j].t {
+                let a = (v[k] - v[j]) / (s[k].t - s[j].t);
+                up = up.max(a);
+                down = down.max(-a);
+            }
+        }
+        time.push(((l.end - l.start).ln(), e.time == TimeClass::Sudden));
+        weight.push(((down / up).ln(), e.weight == WeightClass::Strong));
+    }
+    let (t, w) = (threshold_accuracy(time), threshold_accuracy(weight));
+    eprintln!("single-threshold accuracy: Time {t:.3}, Weight {w:.3}");
+    assert!(t >= 0.85, "Time from duration: {t}");
+    assert!(w >= 0.75, "Weight from stop/start sharpness: {w}");
+}

@@ -155,10 +155,10 @@ impl Draw<'_> {
         Stroke::moving(d, self.shape.profile)
     }
 
-    /// A recovery stroke (same onset and ending, no impact).
+    /// A recovery stroke (wind-up, return): same onset, eased ending, no impact.
     fn recover(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
-        Stroke::moving(d, self.shape.profile.without_impact())
+        Stroke::moving(d, self.shape.profile.recovery())
     }
 }
 
