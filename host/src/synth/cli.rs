@@ -103,11 +103,15 @@ enum SynthCommand {
         knobs: KnobArgs,
     },
     /// One performance of every action (in the order walk, run, jump, punch, throw, kick,
-    /// turn, sidestep, crouch, bow, wave, spin), plotted small on a 4×3 grid.
+    /// turn, sidestep, crouch, bow, wave, spin) plotted small on a 4×3 grid; with `--action`,
+    /// that action in the four effort states (same seed, so only the effort differs), 2×2.
     Gallery {
         /// Master seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Compare the four effort states of this action instead.
+        #[arg(long)]
+        action: Option<Action>,
         /// Effort of every performance (default: a random state each).
         #[arg(long, default_value = "random")]
         effort: EffortArg,
@@ -375,24 +379,37 @@ pub fn run(args: SynthArgs) -> Result<()> {
         }
         SynthCommand::Gallery {
             seed,
+            action,
             effort,
             out,
             knobs,
         } => {
             let knobs = knobs.knobs()?;
-            let pics: Vec<_> = Action::ALL
-                .iter()
-                .enumerate()
-                .map(|(i, &a)| {
-                    let s = super::sequence::item_seed(seed, i as u64);
-                    let e = effort
-                        .0
-                        .unwrap_or_else(|| super::sequence::random_state_for(s));
-                    let d = gesture(s, &knobs, a, e);
-                    (super::plot::plot(&d.log, &d.labels), format!("{a} {e}"))
-                })
-                .collect();
-            super::plot::gallery(&pics, 4)
+            let tile = |s: u64, a: Action, e: Effort| {
+                let d = gesture(s, &knobs, a, e);
+                (super::plot::plot(&d.log, &d.labels), format!("{a} {e}"))
+            };
+            let (pics, cols): (Vec<_>, u32) = match action {
+                Some(a) => (
+                    Effort::STATES.iter().map(|&e| tile(seed, a, e)).collect(),
+                    2,
+                ),
+                None => (
+                    Action::ALL
+                        .iter()
+                        .enumerate()
+                        .map(|(i, &a)| {
+                            let s = super::sequence::item_seed(seed, i as u64);
+                            let e = effort
+                                .0
+                                .unwrap_or_else(|| super::sequence::random_state_for(s));
+                            tile(s, a, e)
+                        })
+                        .collect(),
+                    4,
+                ),
+            };
+            super::plot::gallery(&pics, cols)
                 .save(&out)
                 .with_context(|| format!("writing {}", out.display()))?;
             say(format_args!("{}", out.display()));

@@ -110,7 +110,13 @@ impl Effort {
             WeightClass::Strong => (
                 lerp(1.15, 1.45, amp),
                 lerp(1.0, 1.5, ending),
-                lerp(0.25, 0.4, ring),
+                // A sudden strong stroke hits (arrives at full speed); a sustained one presses
+                // on and stops firmly.
+                if self.time == TimeClass::Sustained {
+                    lerp(0.1, 0.2, ring)
+                } else {
+                    lerp(0.25, 0.4, ring)
+                },
                 lerp(0.8, 0.95, lift),
             ),
             WeightClass::Light => (
