@@ -5,7 +5,7 @@
 //! gesture, e.g. one hop or one thrust):
 //!
 //! * **Time** sets the stroke's duration and its *onset*. Sudden strokes are short
-//!   (×0.42–0.7 of the neutral duration) and start explosively (the velocity profile rises
+//!   (×0.45–0.7 of the neutral duration) and start explosively (the velocity profile rises
 //!   almost at once); sustained strokes are long (×1.5–2.4) and ease in gently.
 //! * **Weight** sets the stroke's amplitude and its *ending*. Strong strokes are bigger
 //!   (×1.15–1.45), arrive with speed and stop in an impact (a damped overshoot), so their
@@ -102,7 +102,7 @@ impl Effort {
         let lift = rng.unit();
         let lerp = |lo: f64, hi: f64, u: f64| lo + (hi - lo) * u;
         let (time_factor, a) = match self.time {
-            TimeClass::Sudden => (lerp(0.42, 0.7, tf), lerp(1.0, 1.4, onset)),
+            TimeClass::Sudden => (lerp(0.45, 0.7, tf), lerp(1.0, 1.4, onset)),
             TimeClass::Sustained => (lerp(1.5, 2.4, tf), lerp(1.9, 2.9, onset)),
             TimeClass::Neutral => (lerp(0.85, 1.2, tf), lerp(1.4, 1.9, onset)),
         };

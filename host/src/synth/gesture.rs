@@ -108,6 +108,9 @@ impl FromStr for Action {
     }
 }
 
+/// How stroke durations grow with the doodle's scale: duration ∝ scale^0.4.
+pub const DURATION_SCALE_EXPONENT: f64 = 0.4;
+
 /// Draws sizes and timings for one performance.
 struct Draw<'a> {
     rng: &'a mut SynthRng,
@@ -116,9 +119,13 @@ struct Draw<'a> {
 }
 
 impl Draw<'_> {
-    /// A stroke duration in seconds from a neutral range.
+    /// A stroke duration in seconds from a neutral range. Bigger doodles take somewhat longer
+    /// (× scale^[`DURATION_SCALE_EXPONENT`]), as bigger arm movements do, so speed grows less
+    /// than linearly with scale.
     fn dur(&mut self, lo: f64, hi: f64) -> f64 {
-        self.rng.uniform(lo, hi) * self.shape.time_factor
+        self.rng.uniform(lo, hi)
+            * self.shape.time_factor
+            * self.scale.max(1e-3).powf(DURATION_SCALE_EXPONENT)
     }
 
     /// A hold duration: effort stretches holds less than strokes.

@@ -30,6 +30,9 @@ pub const WIDTH: u32 = 1200;
 /// Picture height, pixels.
 pub const HEIGHT: u32 = 1000;
 
+/// Length of the heading ticks in the top view, pixels.
+const HEADING_TICK_PX: f64 = 12.0;
+
 /// Half-width of the central difference used for speeds, seconds.
 const SPEED_HALF_WINDOW_S: f64 = 0.02;
 
@@ -219,11 +222,12 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
     // Top view with heading ticks.
     let xz: Vec<(f64, f64)> = pos.iter().map(|p| (p.x, p.z)).collect();
     let map = fit(&xz, top);
-    let tick_len =
-        0.04 * {
-            let (a, b) = (map((0.0, 0.0)), map((1.0, 0.0)));
-            1.0 / (b.0 - a.0).abs().max(1e-9)
-        } * 18.0;
+    // Heading ticks are a fixed number of pixels long, whatever the zoom.
+    let metres_per_pixel = {
+        let (a, b) = (map((0.0, 0.0)), map((1.0, 0.0)));
+        1.0 / (b.0 - a.0).abs().max(1e-9)
+    };
+    let tick_len = HEADING_TICK_PX * metres_per_pixel;
     let mut next_tick = t_lo;
     for i in 1..n {
         c.line(map(xz[i - 1]), map(xz[i]), ramp(frac(i)));
