@@ -152,10 +152,11 @@ fn scale_multiplies_the_spatial_extent() {
         };
         let ((one, t_one), (half, _), (two, t_two)) = (at(1.0), at(0.5), at(2.0));
         let grow = 2f64.powf(figurine_host::synth::gesture::DURATION_SCALE_EXPONENT);
+        // Strokes take scale^0.4 longer; still holds inside a gesture do not stretch.
+        let stretch = t_two / t_one;
         assert!(
-            (t_two / t_one - grow).abs() < 1e-4,
-            "{action}: {}",
-            t_two / t_one
+            stretch > 1.15 && stretch < grow + 1e-4,
+            "{action}: {stretch}"
         );
         assert!(one > 0.005, "{action}: {one}");
         // Same path; bigger doodles also take longer, so sample instants differ (≤ 1 %).
