@@ -102,9 +102,12 @@ enum SynthCommand {
         #[command(flatten)]
         knobs: KnobArgs,
     },
-    /// One performance of every action (in the order walk, run, jump, punch, throw, kick,
-    /// turn, sidestep, crouch, bow, wave, spin) plotted small on a 4×3 grid; with `--action`,
-    /// that action in the four effort states (same seed, so only the effort differs), 2×2.
+    /// A picture of every action, or of one action in the four effort states.
+    ///
+    /// Without `--action`: one performance of every action (walk, run, jump, punch, throw,
+    /// kick, turn, sidestep, crouch, bow, wave, spin) plotted small on a 4×3 grid. With
+    /// `--action`: that action in the four effort states (same seed, so only the effort
+    /// differs), 2×2.
     Gallery {
         /// Master seed.
         #[arg(long, default_value_t = 0)]
