@@ -659,3 +659,30 @@ fn effort_classes_are_learnable_from_scale_free_cues() {
     assert!(t >= 0.85, "Time from duration: {t}");
     assert!(w >= 0.75, "Weight from stop/start sharpness: {w}");
 }
+
+/// The golden doodle: `figurine synth gesture --action jump --effort sudden-strong --seed 1
+/// --rate 30 --out host/tests/golden/synth_jump_seed1.csv`. Regenerate it (after an intended
+/// change of the generator) with `FIGURINE_BLESS=1 cargo test -p figurine-host --test synth golden`.
+#[test]
+fn golden_doodle_is_unchanged() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/synth_jump_seed1.csv");
+    let k = Knobs {
+        rate_hz: Range::fixed(30.0),
+        ..Knobs::default()
+    };
+    let d = gesture(1, &k, Action::Jump, "sudden-strong".parse().unwrap());
+    let scratch_dir = scratch("golden");
+    let fresh = scratch_dir.join("fresh.csv");
+    d.write_csv(&fresh).unwrap();
+    let fresh_text = std::fs::read_to_string(&fresh).unwrap();
+    let _ = std::fs::remove_dir_all(&scratch_dir);
+    if std::env::var_os("FIGURINE_BLESS").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, &fresh_text).unwrap();
+    }
+    let golden = std::fs::read_to_string(&path).expect("golden file (bless with FIGURINE_BLESS=1)");
+    assert_eq!(
+        fresh_text, golden,
+        "the generator's output changed for a fixed seed; if intended, re-bless the golden file"
+    );
+}
