@@ -205,14 +205,14 @@ pub struct EffortShape {
 }
 
 /// Added to the ending exponent of recovery strokes.
-const RECOVERY_EASE: f64 = 0.8;
+pub const RECOVERY_EASE: f64 = 0.8;
 
 /// Number of points of the tabulated progress curve of a [`Profile`].
 const PROFILE_TABLE: usize = 257;
 
 /// Time an impact takes to settle, seconds: a hand stopping a toy hard decelerates within
 /// ~20 ms (the first quarter cycle) and the bounce dies out in ~0.1 s, however long the stroke.
-const IMPACT_SETTLE_S: f64 = 0.1;
+pub const IMPACT_SETTLE_S: f64 = 0.1;
 /// Bounds of the settle's share of a stroke (very short or very long strokes).
 const SETTLE_FRACTION_RANGE: (f64, f64) = (0.05, 0.5);
 
