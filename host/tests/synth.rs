@@ -686,3 +686,52 @@ fn golden_doodle_is_unchanged() {
         "the generator's output changed for a fixed seed; if intended, re-bless the golden file"
     );
 }
+
+mod arbitrary_knobs {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn range(lo: f64, hi: f64) -> impl Strategy<Value = Range> {
+        (lo..=hi, lo..=hi).prop_map(|(a, b)| Range::new(a, b))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        /// Any valid knob setting gives a well-formed, labelled, finite log.
+        #[test]
+        fn any_valid_knobs_give_a_well_formed_log(
+            seed in any::<u64>(),
+            count in 1usize..4,
+            rate in range(5.0, 400.0),
+            jitter in range(0.0, 0.45),
+            drop in range(0.0, 0.5),
+            scale in range(0.01, 5.0),
+            speed in range(0.05, 5.0),
+            heading in range(-720.0, 720.0),
+            tilt in range(0.0, 60.0),
+            noise in range(0.0, 10.0),
+            t0 in range(-1000.0, 1000.0),
+            pause in range(0.0, 2.0),
+        ) {
+            let k = Knobs {
+                rate_hz: rate, jitter, drop, scale, speed, heading_deg: heading, tilt_deg: tilt,
+                noise, t0, pause_s: pause, lead_s: pause,
+                ..Knobs::default()
+            };
+            prop_assert!(k.validate().is_ok());
+            let d = sequence(seed, &k, count, None);
+            let s = &d.log.samples;
+            prop_assert!(s.len() >= 2);
+            prop_assert!(s.windows(2).all(|w| w[1].t > w[0].t));
+            for x in s {
+                prop_assert!(x.pos.iter().chain(&x.quat).all(|v| v.is_finite()));
+                let n: f64 = x.quat.iter().map(|v| v * v).sum::<f64>().sqrt();
+                prop_assert!((n - 1.0).abs() < 1e-9);
+            }
+            prop_assert_eq!(d.labels.len(), count);
+            for l in &d.labels {
+                prop_assert!(l.start < l.end && l.start >= s[0].t && l.end <= s[s.len() - 1].t);
+            }
+        }
+    }
+}
