@@ -20,14 +20,15 @@
 //! +12 8   shift: positions j ≥ 2 with j ∈ follow(j − 1)
 //! +20 8   loops: positions i with i ∈ follow(i)
 //! +28 8   extra: states whose follow set has more than {i, i + 1}
-//! +36 2n  symbol of each position 1..=n (token code < STILL)
+//! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
+//!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
 //! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
 
-use crate::token::{Token, NONE_BIN, STILL};
+use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
 use crate::Error;
 
 /// Maximum number of actions in a library.
@@ -91,8 +92,8 @@ impl<'a> Pattern<'a> {
     fn extra(&self) -> u64 {
         rd_u64(self.rec, 28).unwrap_or(0)
     }
-    /// Token of position `i` (1-based); STILL (matches nothing) when out of range.
-    pub fn symbol(&self, i: usize) -> Token {
+    /// Symbol of position `i` (1-based); STILL (matches nothing) when out of range.
+    pub fn symbol(&self, i: usize) -> Symbol {
         if i == 0 {
             return STILL;
         }
@@ -113,7 +114,7 @@ impl<'a> Pattern<'a> {
     pub fn symbol_mask(&self, t: Token) -> u64 {
         let mut m = 0u64;
         for i in 1..=self.positions() {
-            if self.symbol(i) == t {
+            if symbol_matches(self.symbol(i), t) {
                 m |= 1 << i;
             }
         }
@@ -232,8 +233,7 @@ fn validate(p: Pattern<'_>) -> Result<(), Error> {
         return Err(Error::Capacity);
     }
     for i in 1..=n {
-        let s = p.symbol(i);
-        if s >= STILL || s == NONE_BIN * 27 + NONE_BIN {
+        if !symbol_valid(p.symbol(i)) {
             return Err(Error::Invalid("pattern symbol"));
         }
     }
@@ -282,7 +282,7 @@ fn validate(p: Pattern<'_>) -> Result<(), Error> {
 #[cfg(any(feature = "std", test))]
 pub fn encode_record(
     out: &mut impl Extend<u8>,
-    symbols: &[Token],
+    symbols: &[Symbol],
     follow: &[u64],
     last: u64,
     max_edits: u8,

@@ -238,6 +238,7 @@ impl<'lib> Recognizer<'lib> {
                 end,
                 distance: k,
                 len: (j + 1) as u16,
+                min_len: p.min_len().min(255) as u8,
             };
             if best.is_none_or(|b| c.beats(&b)) {
                 best = Some(c);

@@ -33,6 +33,8 @@ pub struct Candidate {
     pub distance: u8,
     /// Non-STILL tokens covered.
     pub len: u16,
+    /// Shortest match of the action's pattern (its specificity), tokens.
+    pub min_len: u8,
 }
 
 impl Candidate {
@@ -41,9 +43,11 @@ impl Candidate {
         2 * i32::from(self.len) - 3 * i32::from(self.distance)
     }
 
-    /// True when `self` should replace `other`.
+    /// True when `self` should replace `other`: higher merit; at equal merit the more
+    /// specific pattern (longer shortest match), then fewer edits, then the lower index.
     pub fn beats(&self, other: &Candidate) -> bool {
-        (self.merit(), other.distance, other.action) > (other.merit(), self.distance, self.action)
+        (self.merit(), self.min_len, other.distance, other.action)
+            > (other.merit(), other.min_len, self.distance, self.action)
     }
 }
 
@@ -131,6 +135,7 @@ mod tests {
             end,
             distance,
             len: (end - start + 1) as u16,
+            min_len: 1,
         }
     }
 

@@ -36,9 +36,9 @@ pub const TOKEN_COUNT: u16 = 730;
 pub const NONE_BIN: u16 = 13;
 
 /// Component share of its vector norm needed to switch a sign on.
-pub const DOM_ON: f32 = 0.45;
+pub const DOM_ON: f32 = 0.55;
 /// Component share below which an active sign switches off.
-pub const DOM_OFF: f32 = 0.30;
+pub const DOM_OFF: f32 = 0.35;
 /// Translation noise floor, m/s.
 pub const V_FLOOR_M_S: f32 = 0.07;
 /// Rotation noise floor, rad/s (≈ 34 °/s).
@@ -51,6 +51,10 @@ pub const PEAK_TAU_S: f32 = 1.0;
 pub const ARM_M: f32 = 0.03;
 /// Minimum duration of a token, µs.
 pub const MIN_TOKEN_US: u64 = 40_000;
+/// Rotation angle (rad, ≈ 229°) about one axis, in one direction, after which the current run
+/// starts again as a new run of the same token: the string then tells a spin from a turn,
+/// while angles — unlike distances — do not depend on the doodle's size.
+pub const ROT_CHUNK_RAD: f32 = 4.0;
 
 /// Per-tick decay of the peak trackers (first-order: 1 − dt/τ).
 const PEAK_DECAY: f32 = 1.0 - TICK_S / PEAK_TAU_S;
@@ -108,6 +112,82 @@ pub fn write_token<W: fmt::Write>(t: Token, w: &mut W) -> fmt::Result {
         }
     }
     Ok(())
+}
+
+/// Pattern-symbol flag: any rotation half (written `uf~`).
+pub const ANY_ROT: u16 = 1 << 14;
+/// Pattern-symbol flag: any translation half (written `~.Yp`).
+pub const ANY_LIN: u16 = 1 << 15;
+
+/// A pattern symbol: a token code, possibly with one wildcard half ([`ANY_ROT`] with the
+/// rotation half empty, or [`ANY_LIN`] with the translation half empty).
+pub type Symbol = u16;
+
+/// Whether a pattern symbol is well formed.
+pub fn symbol_valid(s: Symbol) -> bool {
+    let code = s & 0x3ff;
+    if code >= STILL || code == NONE_BIN * 27 + NONE_BIN {
+        return false;
+    }
+    match s & (ANY_ROT | ANY_LIN) {
+        0 => s == code,
+        ANY_ROT => code % 27 == NONE_BIN,
+        ANY_LIN => code / 27 == NONE_BIN,
+        _ => false,
+    }
+}
+
+/// Whether token `t` matches pattern symbol `s`.
+#[inline]
+pub fn symbol_matches(s: Symbol, t: Token) -> bool {
+    if t >= STILL {
+        return false;
+    }
+    let code = s & 0x3ff;
+    if s & ANY_ROT != 0 {
+        code / 27 == t / 27
+    } else if s & ANY_LIN != 0 {
+        code % 27 == t % 27
+    } else {
+        code == t
+    }
+}
+
+/// Mirror image of a token under the left–right reflection of the figurine (x → −x):
+/// translation x flips; angular velocity, a pseudovector, keeps x and flips y and z.
+pub fn mirror_token(t: Token) -> Token {
+    if t >= STILL {
+        return t;
+    }
+    let (l, a) = token_signs(t);
+    token_from_signs([-l[0], l[1], l[2]], [a[0], -a[1], -a[2]])
+}
+
+/// Writes a pattern symbol (a token name, `uf~` or `~.Yp`).
+pub fn write_symbol<W: fmt::Write>(s: Symbol, w: &mut W) -> fmt::Result {
+    if s & ANY_LIN != 0 {
+        w.write_char('~')?;
+    }
+    write_token(s & 0x3ff, w)?;
+    if s & ANY_ROT != 0 {
+        w.write_char('~')?;
+    }
+    Ok(())
+}
+
+/// Parses a pattern symbol; `None` if malformed.
+pub fn parse_symbol(name: &str) -> Option<Symbol> {
+    if let Some(rest) = name.strip_suffix('~') {
+        let t = parse_token(rest)?;
+        let s = t | ANY_ROT;
+        return symbol_valid(s).then_some(s);
+    }
+    if let Some(rest) = name.strip_prefix('~') {
+        let t = parse_token(rest)?;
+        let s = t | ANY_LIN;
+        return symbol_valid(s).then_some(s);
+    }
+    parse_token(name).filter(|&t| t != STILL)
 }
 
 /// A token as a `Display` value.
@@ -209,6 +289,7 @@ pub struct Tokenizer {
     ang: [i8; 3],
     current: Option<Token>,
     candidate: Option<(Token, u64)>,
+    turned: [f32; 3],
 }
 
 impl Default for Tokenizer {
@@ -247,6 +328,7 @@ impl Tokenizer {
             ang: [0; 3],
             current: None,
             candidate: None,
+            turned: [0.0; 3],
         }
     }
 
@@ -276,7 +358,26 @@ impl Tokenizer {
             self.current = Some(raw);
             return TokenStep::NewToken { token: raw };
         };
+        // Angle turned about each axis while its sign stays the same, across token changes.
+        let mut chunk = false;
+        for i in 0..3 {
+            if self.ang[i] == 0
+                || (self.turned[i] != 0.0 && (self.turned[i] > 0.0) != (self.ang[i] > 0))
+            {
+                self.turned[i] = 0.0;
+            }
+            if self.ang[i] != 0 {
+                self.turned[i] += k.w[i] * TICK_S;
+                if fmath::abs(self.turned[i]) >= ROT_CHUNK_RAD {
+                    self.turned[i] = 0.0;
+                    chunk = true;
+                }
+            }
+        }
         if raw == cur {
+            if chunk && self.candidate.is_none() && raw != STILL {
+                return TokenStep::NewToken { token: raw };
+            }
             return if self.candidate.take().is_some() {
                 TokenStep::BlipMerged {
                     starts_candidate: false,

@@ -63,6 +63,9 @@ pub struct EvalArgs {
     /// Save the trained effort model here.
     #[arg(long)]
     pub save_effort: Option<PathBuf>,
+    /// Print the token string of every misrecognised isolated gesture.
+    #[arg(long)]
+    pub verbose: bool,
 }
 
 /// Learns every synth action from `n` generated examples.
@@ -77,7 +80,7 @@ pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<Library
             None,
         );
         let logs: Vec<_> = docs.into_iter().map(|d| d.log).collect();
-        lib.upsert(learn_action(action.name(), &logs, None)?);
+        lib.upsert(learn_action(action.name(), &logs, None, true)?);
     }
     Ok(lib)
 }
@@ -215,6 +218,14 @@ pub fn evaluate(
                 s_ok += usize::from(t && w);
                 f.latencies.push(main.map_or(0.0, |e| e.decided - l.end));
             } else {
+                if args.verbose {
+                    let t = super::learn::tokenize_gesture(&d.log);
+                    eprintln!(
+                        "{} -> {got}: {}",
+                        l.action,
+                        super::library::tokens_to_string(&super::learn::tokens_only(&t))
+                    );
+                }
                 *conf.entry((l.action.clone(), got)).or_default() += 1;
             }
         }
