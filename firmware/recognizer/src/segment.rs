@@ -18,7 +18,7 @@ pub const LOOKAHEAD_TOKENS: u8 = 3;
 /// Stillness after a candidate that commits it, µs.
 pub const PAUSE_US: u64 = 60_000;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
-pub const LONG_PAUSE_US: u64 = 1_000_000;
+pub const LONG_PAUSE_US: u64 = 2_500_000;
 
 /// A possible action segment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

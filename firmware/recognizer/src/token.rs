@@ -30,6 +30,10 @@ use crate::intake::{TICK_S, TICK_US};
 pub type Token = u16;
 /// The STILL token.
 pub const STILL: Token = 729;
+/// The half-turn marker (written `O`): a rotation that continues past [`ROT_CHUNK_RAD`] in one
+/// direction about one axis goes on as a run of this token. It uses the one code of the 27×27
+/// grid that motion never produces (both halves empty).
+pub const TURN: Token = NONE_BIN * 27 + NONE_BIN;
 /// Number of distinct token codes (27 × 27 + STILL).
 pub const TOKEN_COUNT: u16 = 730;
 /// The bin code meaning "no component" for one of the two halves.
@@ -96,6 +100,9 @@ pub fn write_token<W: fmt::Write>(t: Token, w: &mut W) -> fmt::Result {
     if t >= STILL {
         return w.write_char('_');
     }
+    if t == TURN {
+        return w.write_char('O');
+    }
     let (lin, ang) = token_signs(t);
     for (i, &s) in lin.iter().enumerate() {
         if s != 0 {
@@ -126,11 +133,12 @@ pub type Symbol = u16;
 /// Whether a pattern symbol is well formed.
 pub fn symbol_valid(s: Symbol) -> bool {
     let code = s & 0x3ff;
-    if code >= STILL || code == NONE_BIN * 27 + NONE_BIN {
+    if code >= STILL {
         return false;
     }
     match s & (ANY_ROT | ANY_LIN) {
         0 => s == code,
+        _ if code == TURN => false,
         ANY_ROT => code % 27 == NONE_BIN,
         ANY_LIN => code / 27 == NONE_BIN,
         _ => false,
@@ -156,7 +164,7 @@ pub fn symbol_matches(s: Symbol, t: Token) -> bool {
 /// Mirror image of a token under the left–right reflection of the figurine (x → −x):
 /// translation x flips; angular velocity, a pseudovector, keeps x and flips y and z.
 pub fn mirror_token(t: Token) -> Token {
-    if t >= STILL {
+    if t >= STILL || t == TURN {
         return t;
     }
     let (l, a) = token_signs(t);
@@ -204,6 +212,9 @@ impl fmt::Display for TokenName {
 pub fn parse_token(s: &str) -> Option<Token> {
     if s == "_" {
         return Some(STILL);
+    }
+    if s == "O" {
+        return Some(TURN);
     }
     let b = s.as_bytes();
     let mut lin = [0i8; 3];
@@ -376,7 +387,9 @@ impl Tokenizer {
         }
         if raw == cur {
             if chunk && self.candidate.is_none() && raw != STILL {
-                return TokenStep::NewToken { token: raw };
+                // A marker run opens; `current` stays the rotating token, so the marker run
+                // lasts while the rotation does (see `TURN`).
+                return TokenStep::NewToken { token: TURN };
             }
             return if self.candidate.take().is_some() {
                 TokenStep::BlipMerged {
@@ -423,9 +436,6 @@ mod tests {
         for t in 0..TOKEN_COUNT {
             let mut s = String::new();
             write_token(t, &mut s).unwrap();
-            if t == NONE_BIN * 27 + NONE_BIN {
-                continue; // never produced: both halves empty is STILL
-            }
             assert_eq!(parse_token(&s), Some(t), "{t} {s}");
         }
         assert_eq!(parse_token("uf"), Some(token_from_signs([0, 1, 1], [0; 3])));

@@ -21,7 +21,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
-use figurine_recognizer::token::{mirror_token, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL};
+use figurine_recognizer::token::{
+    mirror_token, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
+};
 use figurine_recognizer::Library;
 
 use super::dtw;
@@ -129,7 +131,8 @@ pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
 
 fn mandatory_flags(t: &Tokenized) -> Vec<bool> {
     let total: f64 = t.iter().map(|x| x.1).sum();
-    t.iter().map(|x| x.1 >= MANDATORY_SHARE * total).collect()
+    // The half-turn marker is always deliberate, however short its run.
+    t.iter().map(|x| x.0 == TURN || x.1 >= MANDATORY_SHARE * total).collect()
 }
 
 /// Mandatory runs (token, index in `t`); a repeat of the previous mandatory token separated
@@ -176,7 +179,9 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         // A pure translation or a pure rotation is what the performer meant; the other half
         // (a wobble, the figurine held off-centre) may come and go.
         let (lin, ang) = (t / 27, t % 27);
-        if ang == NONE_BIN {
+        if t == TURN {
+            out.insert(t);
+        } else if ang == NONE_BIN {
             out.insert(t | ANY_ROT);
         } else if lin == NONE_BIN {
             out.insert(t | ANY_LIN);
