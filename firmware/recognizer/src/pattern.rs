@@ -15,7 +15,7 @@
 //! +0  1   n: positions (1 ≤ n ≤ MAX_POSITIONS)
 //! +1  1   max_edits: per-action edit bound (≤ MAX_EDITS, < min_len)
 //! +2  1   min_len: length of the shortest token string the pattern accepts (≥ 1)
-//! +3  1   reserved, zero
+//! +3  1   flags: bit 0 = cyclic (the whole pattern repeats, e.g. `(uf~ df~)+`); others zero
 //! +4  8   last: accepting positions
 //! +12 8   shift: positions j ≥ 2 with j ∈ follow(j − 1)
 //! +20 8   loops: positions i with i ∈ follow(i)
@@ -119,6 +119,11 @@ impl<'a> Pattern<'a> {
             }
         }
         m
+    }
+    /// Whether the action is cyclic: its whole pattern repeats (walk, wave …), so a short
+    /// pause does not end it.
+    pub fn cyclic(&self) -> bool {
+        self.rec.get(3).is_some_and(|f| f & 1 != 0)
     }
     /// Forward transition: all states reachable from a state of `d` in one step.
     #[inline]
@@ -226,8 +231,8 @@ impl<'a> Library<'a> {
 fn validate(p: Pattern<'_>) -> Result<(), Error> {
     let n = p.positions();
     let valid: u64 = ((1u64 << (n + 1)) - 1) & !1;
-    if p.rec.get(3) != Some(&0) {
-        return Err(Error::Invalid("reserved bytes"));
+    if p.rec.get(3).is_none_or(|f| f & !1 != 0) {
+        return Err(Error::Invalid("reserved flag bits"));
     }
     if p.max_edits() > MAX_EDITS {
         return Err(Error::Capacity);
@@ -286,6 +291,7 @@ pub fn encode_record(
     follow: &[u64],
     last: u64,
     max_edits: u8,
+    cyclic: bool,
 ) -> Result<usize, Error> {
     let n = symbols.len();
     if n == 0 || n > MAX_POSITIONS || follow.len() != n + 1 {
@@ -324,7 +330,7 @@ pub fn encode_record(
         reach = next;
         min_len += 1;
     }
-    out.extend([n as u8, max_edits, min_len, 0]);
+    out.extend([n as u8, max_edits, min_len, u8::from(cyclic)]);
     for v in [last, shift, loops, extra] {
         out.extend(v.to_le_bytes());
     }
@@ -356,7 +362,7 @@ pub(crate) mod tests {
             for (i, f) in follow.iter_mut().enumerate().skip(1) {
                 *f = (1 << i) | if i < n { 1 << (i + 1) } else { 0 };
             }
-            encode_record(&mut out, &syms, &follow, 1 << n, *k).unwrap();
+            encode_record(&mut out, &syms, &follow, 1 << n, *k, false).unwrap();
         }
         out
     }

@@ -249,6 +249,14 @@ pub fn evaluate(
         let evs = run_doodle(&d, &names, &blob, effort)?;
         n_ev += evs.len();
         n_lab += d.labels.len();
+        if args.verbose && k < 3 {
+            for l in &d.labels {
+                eprintln!("  label {:<9} {:7.2} {:7.2}", l.action, l.start, l.end);
+            }
+            for e in &evs {
+                eprintln!("  event {:<9} {:7.2} {:7.2}", e.action, e.start, e.end);
+            }
+        }
         let mut used = vec![false; evs.len()];
         for l in &d.labels {
             let best = evs

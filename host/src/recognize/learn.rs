@@ -264,8 +264,14 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     else {
         bail!("no motion found in any example (all still?)");
     };
-    // Cyclic when some performance has clearly more parts than the reference.
-    let cyclic = counts.iter().any(|&c| 2 * c >= 3 * counts[best].max(1));
+    // Cyclic when some performance is closer to the reference done twice than once.
+    let mand_of = |s: &Tokenized| -> Vec<Token> { mandatory_runs(s).iter().map(|m| m.0).collect() };
+    let once = mand_of(seqs[best]);
+    let twice: Vec<Token> = once.iter().chain(once.iter()).copied().collect();
+    let cyclic = seqs.iter().any(|s| {
+        let m = mand_of(s);
+        edit_distance(&m, &twice) < edit_distance(&m, &once)
+    });
     seqs.swap(0, best);
     let reference = seqs[0];
     let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();

@@ -39,6 +39,8 @@ pub struct Compiled {
     pub follow: Vec<u64>,
     /// Accepting positions.
     pub last: u64,
+    /// The whole expression is a `(…)+`: a cyclic action.
+    pub cyclic: bool,
 }
 
 struct Parser<'a> {
@@ -205,6 +207,8 @@ impl Regex {
             symbols,
             follow,
             last: g.last,
+            cyclic: matches!(self, Regex::Plus(_))
+                || matches!(self, Regex::Alt(v) if v.iter().all(|r| matches!(r, Regex::Plus(_)))),
         })
     }
 }
@@ -315,7 +319,7 @@ impl Compiled {
     /// The device record (see `figurine_recognizer::pattern` for the layout).
     pub fn record(&self, max_edits: u8) -> Result<Vec<u8>> {
         let mut out = Vec::new();
-        encode_record(&mut out, &self.symbols, &self.follow, self.last, max_edits)
+        encode_record(&mut out, &self.symbols, &self.follow, self.last, max_edits, self.cyclic)
             .map_err(|e| anyhow::anyhow!("cannot encode pattern: {e}"))?;
         Ok(out)
     }
