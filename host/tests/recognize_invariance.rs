@@ -12,10 +12,20 @@ use figurine_recognizer::token::STILL;
 fn actions(knobs: &Knobs, action: Action, seed: u64) -> (Vec<String>, Vec<u16>) {
     let d = synth::gesture(seed, knobs, action, Effort::NEUTRAL);
     let (lib, blob) = load_library(None).unwrap();
-    let sim = simulate_log(&d.log, &lib.names(), &blob, Some(load_effort(None).unwrap())).unwrap();
+    let sim = simulate_log(
+        &d.log,
+        &lib.names(),
+        &blob,
+        Some(load_effort(None).unwrap()),
+    )
+    .unwrap();
     let (samples, _) = log_samples(&d.log);
     let runs = log_runs(&samples);
-    let tokens = gesture_runs(&runs).iter().map(|r| r.token).filter(|&t| t != STILL).collect();
+    let tokens = gesture_runs(&runs)
+        .iter()
+        .map(|r| r.token)
+        .filter(|&t| t != STILL)
+        .collect();
     // The actions recognised, in order; a cyclic action cut into consecutive events is one.
     let mut names: Vec<String> = sim.records.into_iter().map(|r| r.action).collect();
     names.dedup();
@@ -35,7 +45,10 @@ fn same_actions(variant: impl Fn(&mut Knobs), label: &str) -> usize {
         if x == y {
             same += 1;
         } else {
-            eprintln!("{label}: {} gave {x:?} / {y:?}\n  tokens {tx:?}\n  vs     {ty:?}", a.name());
+            eprintln!(
+                "{label}: {} gave {x:?} / {y:?}\n  tokens {tx:?}\n  vs     {ty:?}",
+                a.name()
+            );
         }
     }
     same

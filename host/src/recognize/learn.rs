@@ -132,7 +132,9 @@ pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
 fn mandatory_flags(t: &Tokenized) -> Vec<bool> {
     let total: f64 = t.iter().map(|x| x.1).sum();
     // The half-turn marker is always deliberate, however short its run.
-    t.iter().map(|x| x.0 == TURN || x.1 >= MANDATORY_SHARE * total).collect()
+    t.iter()
+        .map(|x| x.0 == TURN || x.1 >= MANDATORY_SHARE * total)
+        .collect()
 }
 
 /// Mandatory runs (token, index in `t`); a repeat of the previous mandatory token separated

@@ -319,8 +319,15 @@ impl Compiled {
     /// The device record (see `figurine_recognizer::pattern` for the layout).
     pub fn record(&self, max_edits: u8) -> Result<Vec<u8>> {
         let mut out = Vec::new();
-        encode_record(&mut out, &self.symbols, &self.follow, self.last, max_edits, self.cyclic)
-            .map_err(|e| anyhow::anyhow!("cannot encode pattern: {e}"))?;
+        encode_record(
+            &mut out,
+            &self.symbols,
+            &self.follow,
+            self.last,
+            max_edits,
+            self.cyclic,
+        )
+        .map_err(|e| anyhow::anyhow!("cannot encode pattern: {e}"))?;
         Ok(out)
     }
 
