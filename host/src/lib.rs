@@ -7,3 +7,4 @@ pub mod data;
 pub mod events;
 pub mod motion;
 pub mod poselog;
+pub mod synth;

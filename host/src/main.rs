@@ -19,6 +19,8 @@ enum Command {
     Animate(figurine_host::anim::cli::AnimateArgs),
     /// Inspect motion clips (`clip stages CLIP`).
     Clip(figurine_host::anim::cli::ClipArgs),
+    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+    Synth(figurine_host::synth::cli::SynthArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -29,6 +31,7 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Synth(args) => figurine_host::synth::cli::run(args)?,
     }
     Ok(())
 }
