@@ -207,12 +207,13 @@ fn root_follows_the_mapped_doodle_and_timing_matches_the_events() {
         for (p, e) in asm.placements.iter().zip(&events) {
             assert_eq!(p.action, e.action);
             assert!(
-                (p.start_frame as f32 / fps - e.start as f32).abs() <= 1.0 / fps,
+                (asm.t_origin as f32 + p.start_frame as f32 / fps - e.start as f32).abs()
+                    <= 1.0 / fps,
                 "{} start",
                 p.action
             );
             assert!(
-                (p.end_frame as f32 / fps - e.end as f32).abs() <= 1.0 / fps,
+                (asm.t_origin as f32 + p.end_frame as f32 / fps - e.end as f32).abs() <= 1.0 / fps,
                 "{} end",
                 p.action
             );
@@ -241,11 +242,11 @@ fn root_follows_the_mapped_doodle_and_timing_matches_the_events() {
             "foot below ground: {}",
             lowest_foot(&asm)
         );
-        let total = events.last().unwrap().end as f32 + opts.hold_s;
+        let total = (events.last().unwrap().end - asm.t_origin) as f32 + opts.hold_s;
         assert!((asm.clip.duration() - total).abs() <= 1.5 / fps);
         if seed == 1 {
             let png = out_dir().join("story.png");
-            figurine_host::anim::cli::plot_assembly(&asm, &png).unwrap();
+            figurine_host::anim::cli::plot_assembly(&asm, lib.forward(), &png).unwrap();
             eprintln!("contact sheet: {}", png.display());
         }
     }
@@ -450,4 +451,98 @@ fn cli_writes_bvh_glb_and_plot_that_read_back() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("teleport"));
     let _ = Path::new("");
+}
+
+/// Peak joint speed (m/s) per frame of an animation.
+fn joint_speed_per_frame(asm: &Assembly) -> Vec<f32> {
+    let pos = asm.clip.all_positions();
+    let dt = asm.clip.frame_time;
+    (1..pos.len())
+        .map(|f| {
+            pos[f]
+                .iter()
+                .zip(&pos[f - 1])
+                .map(|(a, b)| (*a - *b).length() / dt)
+                .fold(0.0f32, f32::max)
+        })
+        .collect()
+}
+
+#[test]
+fn transitions_do_not_pop() {
+    if setup().is_none() {
+        return;
+    }
+    let (log, events) = doodle(&story(), 100.0, 1, 1.0);
+    let asm = run(&events, Some(&log));
+    let v = joint_speed_per_frame(&asm);
+    let inside: f32 = asm
+        .placements
+        .iter()
+        .flat_map(|p| (p.start_frame + 8)..p.end_frame.saturating_sub(8))
+        .filter_map(|f| v.get(f))
+        .copied()
+        .fold(0.0, f32::max);
+    for &(i, j) in &asm.transitions {
+        let peak = v[i.saturating_sub(2)..(j + 2).min(v.len())]
+            .iter()
+            .copied()
+            .fold(0.0f32, f32::max);
+        eprintln!(
+            "transition {i}-{j}: peak joint speed {peak:.2} m/s (inside actions {inside:.2})"
+        );
+        assert!(peak <= inside.max(4.0), "pop at {i}-{j}: {peak}");
+    }
+}
+
+/// Labels of `figurine synth` as events, as `figurine animate --labels` reads them.
+fn label_events(labels: &[figurine_host::synth::sequence::Label]) -> Vec<ActionRecord> {
+    let dir = out_dir();
+    let path = dir.join(format!("labels_{}.json", labels.len()));
+    std::fs::write(&path, serde_json::to_string(labels).unwrap()).unwrap();
+    figurine_host::anim::cli::read_label_events(&path).unwrap()
+}
+
+#[test]
+fn random_synthetic_doodles_animate_within_bounds() {
+    if setup().is_none() {
+        return;
+    }
+    let knobs = figurine_host::synth::knobs::Knobs::default();
+    let (lib, clips) = setup().unwrap();
+    for seed in [101u64, 202, 303, 404] {
+        let d = figurine_host::synth::sequence::sequence(seed, &knobs, 6, None);
+        let events = label_events(&d.labels);
+        let asm = assemble(
+            &events,
+            Some(&d.log),
+            &clips,
+            lib.forward(),
+            &AssembleOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(asm.placements.len(), events.len());
+        let fps = asm.clip.fps();
+        for (p, e) in asm.placements.iter().zip(&events) {
+            // Starts match (an action may wait for a previous one that overran).
+            let start = asm.t_origin as f32 + p.start_frame as f32 / fps;
+            assert!(start + 1.0 / fps >= e.start as f32, "{seed} {}", p.action);
+            if p.moving && p.path.length() > 0.3 {
+                let worst = (p.start_frame..=p.end_frame)
+                    .map(|f| p.path.distance(ground(asm.clip.frames[f].translations[0])))
+                    .fold(0.0f32, f32::max);
+                assert!(worst <= PATH_BOUND_M, "seed {seed} {}: {worst}", p.action);
+            }
+        }
+        assert!(asm
+            .clip
+            .frames
+            .iter()
+            .all(|p| p.rotations.iter().all(|q| q.is_finite())));
+        assert!(
+            lowest_foot(&asm) >= -1e-3,
+            "seed {seed}: {}",
+            lowest_foot(&asm)
+        );
+    }
 }

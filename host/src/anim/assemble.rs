@@ -1,8 +1,8 @@
 //! The assembler: recognised actions + doodle → one character animation (seed 000 §6).
 //!
 //! For each event (in time order) the action's clip gets its efforts (retime, rescale,
-//! reshape), is stretched over the event's `[start, end]` on the output clock (seconds of the
-//! log's clock, so timing matches the events), and is placed in the world:
+//! reshape), is stretched over the event's `[start, end]` (output frame f shows log time
+//! `t_origin + f / fps`, so timing matches the events), and is placed in the world:
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
 //! - **moving, cyclic** (walk, run): whole cycles, as many as fit the path (`round(L / C)`,
@@ -13,6 +13,8 @@
 //!   with the clip's own travel, during the execution (stage boundaries from phrasing can
 //!   fall inside the take-off, so the clip's travel, not the label, decides).
 //!
+//! Actions start at their event's start; an event shorter than its clip allows at
+//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
 //! Finally ground penetration is removed with two-bone IK and foot contacts are reported.
@@ -31,6 +33,9 @@ use super::AnimError;
 use crate::events::ActionRecord;
 use crate::motion::{Clip, Pose};
 use crate::poselog::PoseLog;
+
+/// Fastest playback of a clip relative to its own speed (before effort retiming).
+pub const MAX_SPEEDUP: f32 = 2.5;
 
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,7 +79,7 @@ pub struct Placement {
     pub moving: bool,
     /// Cycles played (cyclic actions), else 1.
     pub cycles: usize,
-    /// Stages on the output clock: (stage, start s, end s).
+    /// Stages on the log's clock: (stage, start s, end s).
     pub stages: Vec<(Stage, f32, f32)>,
 }
 
@@ -91,6 +96,9 @@ pub struct Assembly {
     pub ground: GroundFix,
     /// Transitions: (frame where the blend starts, frame where it ends).
     pub transitions: Vec<(usize, usize)>,
+    /// Log-clock time (seconds) of output frame 0: the doodle's first sample, else 0 (or the
+    /// first event's start if it is negative). Frame f shows log time `t_origin + f / fps`.
+    pub t_origin: f64,
 }
 
 /// One placed action: its frames on the output clock.
@@ -162,8 +170,13 @@ pub fn assemble(
         .cloned()
         .collect();
     evs.sort_by(|a, b| a.start.total_cmp(&b.start));
-    let t_shift = evs.first().map(|e| e.start.min(0.0)).unwrap_or(0.0);
     let path = doodle.map(|d| GroundPath::from_log(d, opts.world_scale));
+    // Output time 0 is the doodle's first sample (or the log clock's 0 without a doodle).
+    let first_event = evs.first().map(|e| e.start).unwrap_or(0.0);
+    let t_shift = match path.as_ref().and_then(|p| p.t.first()) {
+        Some(&t0) => (t0 as f64).min(first_event),
+        None => first_event.min(0.0),
+    };
     let fps = opts.fps;
     let frame_of = |t: f64| ((t - t_shift) as f32 * fps).round().max(0.0) as usize;
 
@@ -188,7 +201,10 @@ pub fn assemble(
         if !placed.is_empty() && f0 < last_f1 {
             f0 = last_f1; // overlapping events: the later one starts when the earlier ends
         }
-        let f1 = frame_of(ev.end).max(f0 + 2);
+        // Never faster than MAX_SPEEDUP × the clip: a too-short event overruns into the pause
+        // after it (the next action waits if it must).
+        let min_len = (ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
+        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
         let phrasing = phrasings
             .entry(ev.action.clone())
             .or_insert_with(|| {
@@ -206,8 +222,9 @@ pub fn assemble(
         let ec = apply_effort(&ac.clip, &phrasing, effort, forward);
         let duration = (f1 - f0) as f32 / fps;
         let chunk = match &path {
-            Some(p) if ac.moving => p.chunk((ev.start - t_shift) as f32, (ev.end - t_shift) as f32),
-            _ => natural_path(ac, duration),
+            _ if !ac.moving => Polyline::new(Vec::new()),
+            Some(p) => p.chunk(ev.start as f32, ev.end as f32),
+            None => natural_path(ac, duration),
         };
         let (poses, world_path, cycles) =
             place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0);
@@ -217,7 +234,7 @@ pub fn assemble(
             .iter()
             .filter_map(|s| {
                 let (a, b) = ec.stage_w(s.stage)?;
-                let t0 = f0 as f32 / fps;
+                let t0 = f0 as f32 / fps + t_shift as f32;
                 Some((s.stage, t0 + a * duration, t0 + b * duration))
             })
             .collect();
@@ -309,6 +326,7 @@ pub fn assemble(
         contacts,
         ground,
         transitions: cuts,
+        t_origin: t_shift,
     })
 }
 
@@ -428,7 +446,12 @@ fn place_action(
         let r = pose.translations[0];
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
-            (base + rot2(r_start, ground(r - r0)), r_start)
+            let drift = if ac.anchor {
+                ground(rl - r0) * (ec.source_time(w) / clip.duration().max(1e-6))
+            } else {
+                Vec2::ZERO
+            };
+            (base + rot2(r_start, ground(r - r0) - drift), r_start)
         } else if ac.cyclic {
             let s = (cycle as f32 * cycle_len + along(r - r0)) * stretch;
             let tangent = chunk.tangent_at(s, 0.3).unwrap_or(start_heading);

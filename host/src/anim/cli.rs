@@ -9,7 +9,7 @@ use super::library::ClipLibrary;
 use super::phrasing::detect_stages;
 use super::plot::save_contact_sheet;
 use super::trajectory::DEFAULT_WORLD_SCALE;
-use crate::events::read_events_path;
+use crate::events::{read_events_path, ActionRecord};
 use crate::motion::{read_bvh_path, read_deepmimic_path, write_bvh_path, write_glb_path, Clip};
 use crate::poselog::PoseLog;
 
@@ -28,6 +28,10 @@ pub struct AnimateArgs {
     /// Recognised actions as JSON lines (the output of `figurine simulate`).
     #[arg(long)]
     pub events: Option<PathBuf>,
+    /// Ground-truth labels of `figurine synth` (JSON array) used as the events, with each
+    /// Laban class mapped to ±[`LABEL_EFFORT`] (demo and tests without recognition).
+    #[arg(long, conflicts_with = "events")]
+    pub labels: Option<PathBuf>,
     /// The doodle's pose log, whose path the character follows (defaults to LOG).
     #[arg(long)]
     pub doodle: Option<PathBuf>,
@@ -48,6 +52,36 @@ pub struct AnimateArgs {
     /// Also draw a contact sheet (root path over the doodle path, stick figures) to this PNG.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+}
+
+/// Effort value given to a labelled Laban class (sudden/strong +, sustained/light −).
+pub const LABEL_EFFORT: f64 = 0.8;
+
+/// Reads `figurine synth` labels as action events (classes → ±[`LABEL_EFFORT`], neutral 0).
+pub fn read_label_events(path: &Path) -> anyhow::Result<Vec<ActionRecord>> {
+    use crate::synth::effort::{TimeClass, WeightClass};
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let labels: Vec<crate::synth::sequence::Label> = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line()))?;
+    Ok(labels
+        .into_iter()
+        .map(|l| ActionRecord {
+            action: l.action,
+            start: l.start,
+            end: l.end,
+            time: match l.time_class {
+                TimeClass::Sudden => LABEL_EFFORT,
+                TimeClass::Sustained => -LABEL_EFFORT,
+                TimeClass::Neutral => 0.0,
+            },
+            weight: match l.weight_class {
+                WeightClass::Strong => LABEL_EFFORT,
+                WeightClass::Light => -LABEL_EFFORT,
+                WeightClass::Neutral => 0.0,
+            },
+            distance: 0,
+        })
+        .collect())
 }
 
 /// `figurine clip …`: inspect motion clips.
@@ -77,9 +111,10 @@ pub enum ClipCommand {
 
 /// Runs `figurine animate`.
 pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
-    let events_path = match (&args.events, &args.log) {
-        (Some(e), _) => e.clone(),
-        (None, Some(log)) => bail!(
+    let events = match (&args.events, &args.labels, &args.log) {
+        (Some(e), _, _) => read_events_path(e)?,
+        (None, Some(l), _) => read_label_events(l)?,
+        (None, None, Some(log)) => bail!(
             "recognising {} inside `animate` needs the recognizer's simulate step, which this \
              build does not include yet: run `figurine simulate --library LIB.json --jsonl {} > \
              EVENTS.jsonl`, then `figurine animate --events EVENTS.jsonl --doodle {} --out …`",
@@ -87,12 +122,12 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
             log.display(),
             log.display()
         ),
-        (None, None) => {
-            bail!("give --events EVENTS.jsonl (and --doodle LOG.csv), or a LOG to recognise")
-        }
+        (None, None, None) => bail!(
+            "give --events EVENTS.jsonl (or --labels LABELS.json) and --doodle LOG.csv, or a LOG \
+             to recognise"
+        ),
     };
     let _ = (&args.library, &args.effort); // used by the recognise path
-    let events = read_events_path(&events_path)?;
     let doodle_path = args.doodle.as_ref().or(args.log.as_ref());
     let doodle = doodle_path.map(|p| PoseLog::read_path(p)).transpose()?;
     let library = match &args.clips {
@@ -112,14 +147,14 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
         write_glb_path(&asm.clip, 1.0, glb)?;
     }
     if let Some(png) = &args.plot {
-        plot_assembly(&asm, png)?;
+        plot_assembly(&asm, library.forward(), png)?;
     }
     print_summary(&asm, &args.out, args.glb.as_deref());
     Ok(())
 }
 
 /// Draws the assembly's contact sheet: every action's path and a figure per action.
-pub fn plot_assembly(asm: &Assembly, png: &Path) -> anyhow::Result<()> {
+pub fn plot_assembly(asm: &Assembly, forward: glam::Vec3, png: &Path) -> anyhow::Result<()> {
     let target: Vec<glam::Vec3> = asm
         .placements
         .iter()
@@ -132,29 +167,28 @@ pub fn plot_assembly(asm: &Assembly, png: &Path) -> anyhow::Result<()> {
                 .chain([glam::Vec3::NAN])
         })
         .collect();
+    // Two to four figures per action, twelve at most.
+    let per = (super::plot::MAX_FIGURES / asm.placements.len().max(1)).clamp(2, 4);
     let frames: Vec<usize> = asm
         .placements
         .iter()
         .flat_map(|p| {
             let n = p.end_frame - p.start_frame;
-            [
-                p.start_frame + n / 4,
-                p.start_frame + n / 2,
-                p.start_frame + 3 * n / 4,
-            ]
+            (0..per).map(move |k| p.start_frame + n * (2 * k + 1) / (2 * per))
         })
         .collect();
-    save_contact_sheet(&asm.clip, &frames, &target, png)
+    save_contact_sheet(&asm.clip, &frames, &target, forward, png)
 }
 
 fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
     let c = &asm.clip;
     println!(
-        "{}: {} frames @ {:.0} fps ({:.2} s), {} actions, {} transitions",
+        "{}: {} frames @ {:.0} fps ({:.2} s from log time {:.2} s), {} actions, {} transitions",
         out.display(),
         c.len(),
         c.fps(),
         c.duration(),
+        asm.t_origin,
         asm.placements.len(),
         asm.transitions.len()
     );
@@ -170,8 +204,8 @@ fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
         println!(
             "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]",
             p.action,
-            p.start_frame as f32 * c.frame_time,
-            p.end_frame as f32 * c.frame_time,
+            asm.t_origin as f32 + p.start_frame as f32 * c.frame_time,
+            asm.t_origin as f32 + p.end_frame as f32 * c.frame_time,
             if p.moving { "moving" } else { "in place" },
             if p.cycles > 1 {
                 format!(" ×{}", p.cycles)

@@ -8,10 +8,14 @@
 //!   sustained anticipation `(0.5 Lt + 1) t`, execution `(1 − 2 Lt) t^(1 − 0.4 Lt)`; other
 //!   stages keep their timing. Sudden executions get shorter and start with an acceleration,
 //!   sustained ones longer and decelerating.
-//! - **Weight** (§6.4.2): arc-length reparametrisation `L_i = V_i^(α Lw) Δt + L_{i−1}` with
-//!   α = [`ALPHA`] and V the mean joint speed normalised by its clip mean and floored at
-//!   [`SPEED_FLOOR`] (the seed clamps to avoid the divergence of `V^(αLw)` for light
-//!   motions); then eq. 7 over every stage with `c = Lw + 1` (strong) or `1 / (1 − Lw)`
+//! - **Weight** (§6.4.2): arc-length reparametrisation `L_i = V_i^k Δt + L_{i−1}`, traversed
+//!   uniformly in output time, with V the mean joint speed normalised by its clip mean and
+//!   floored at [`SPEED_FLOOR`]. Read literally, the seed's `k = α Lw` (α = [`ALPHA`]) would
+//!   make strong motions *more* uniform (uniform arc length is uniform speed at k = 1) and
+//!   light ones diverge near V = 0, the opposite of its stated aim; we implement the aim: the
+//!   output speed goes as `V^(1 − k)` with `k = −α Lw` for strong (speed variations amplified)
+//!   and `k = min(α |Lw|, 1)` for light (flattened, "between 0 and 1": at full lightness the
+//!   speed is uniform). Then eq. 7 over every stage with `c = Lw + 1` (strong) or `1 / (1 − Lw)`
 //!   (light); then reshaping: every spine bone (the chain from the root to the head, found
 //!   automatically) is rotated by `δθ = 0.1 · Lw` rad about the body's lateral axis, strong
 //!   sinking forward, light rising.
@@ -153,6 +157,13 @@ pub fn apply_effort(clip: &Clip, phrasing: &Phrasing, effort: Effort, forward: V
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
     let speeds = joint_speeds(clip);
     let mean = speeds.iter().sum::<f32>() / speeds.len().max(1) as f32;
+    // Output time spent per source second ∝ V^k: k < 0 makes fast parts faster and slow parts
+    // slower (strong); 0 < k ≤ 1 evens the speed out (light), k = 1 being uniform speed.
+    let k = if e.weight >= 0.0 {
+        -ALPHA * e.weight
+    } else {
+        (ALPHA * -e.weight).min(1.0)
+    };
     let mut arc = vec![0.0f32; n];
     for i in 1..n {
         let v = if mean > 1e-9 {
@@ -160,7 +171,7 @@ pub fn apply_effort(clip: &Clip, phrasing: &Phrasing, effort: Effort, forward: V
         } else {
             1.0
         };
-        arc[i] = arc[i - 1] + v.powf(ALPHA * e.weight) * dt;
+        arc[i] = arc[i - 1] + v.powf(k) * dt;
     }
     let total_src = (n.saturating_sub(1)) as f32 * dt;
     let total_arc = arc.last().copied().unwrap_or(0.0).max(1e-9);

@@ -12,7 +12,8 @@
 //! ```
 //! `moving` actions follow the doodle's path, others play in place (§6.2); `cyclic` actions
 //! repeat whole cycles along the path. `frames` picks an inclusive frame range, `pingpong`
-//! plays it backwards then forwards, `scale` turns a BVH clip's unit into metres (default
+//! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
+//! `scale` turns a BVH clip's unit into metres (default
 //! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces in its clips.
 //! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
 //! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
@@ -49,6 +50,11 @@ pub struct ActionSpec {
     /// Play the range backwards, then forwards (e.g. a rise played as down-and-up).
     #[serde(default)]
     pub pingpong: bool,
+    /// In-place actions only: remove the clip's net ground drift (linearly over the clip) so
+    /// the character ends where it started, as the seed's in-place rule has it. For clips
+    /// that travel although their action should not (DeepMimic's spin); feet slide a little.
+    #[serde(default)]
+    pub anchor: bool,
     /// Length unit → metres for BVH clips (default 0.01).
     #[serde(default)]
     pub scale: Option<f32>,
@@ -104,6 +110,8 @@ pub struct ActionClip {
     pub moving: bool,
     /// Repeats in cycles.
     pub cyclic: bool,
+    /// In place and anchored: the clip's net ground drift is removed.
+    pub anchor: bool,
 }
 
 impl ClipLibrary {
@@ -284,6 +292,7 @@ impl ClipLibrary {
                     clip,
                     moving: spec.moving,
                     cyclic: spec.cyclic,
+                    anchor: spec.anchor && !spec.moving,
                 },
             );
         }

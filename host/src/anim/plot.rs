@@ -9,16 +9,22 @@ use image::{Rgb, RgbImage};
 
 use crate::motion::Clip;
 
-/// Width and height of one panel, pixels.
+/// Width and height of the top-view panel, pixels.
 pub const PANEL: u32 = 600;
+/// Side of one figure cell, pixels (cells sit in a 4 × 3 grid right of the top view).
+pub const CELL: u32 = 200;
+/// Figure cells per sheet.
+pub const MAX_FIGURES: usize = 12;
+/// Width of the world square shown in a cell, metres.
+const CELL_SPAN_M: f32 = 2.4;
 
-/// Draws the sheet: left, top view (X right, Z down) of the clip's root path (blue), the
-/// target path (red) and the feet's lowest points; right, side view (X right, Y up) of stick
-/// figures at `frames` (dark → light in time) over the ground line.
-pub fn contact_sheet(clip: &Clip, frames: &[usize], target: &[Vec3]) -> RgbImage {
-    let mut img = RgbImage::from_pixel(PANEL * 2, PANEL, Rgb([255, 255, 255]));
+/// Draws the sheet: left, top view (X right, Z down) of the clip's root path (blue) over the
+/// target path (red; NaN points break it); right, up to [`MAX_FIGURES`] stick figures at
+/// `frames`, each seen from its side (horizontal axis = its facing, from the rig's `forward`
+/// carried by the root) over the ground line, dark → light in time.
+pub fn contact_sheet(clip: &Clip, frames: &[usize], target: &[Vec3], forward: Vec3) -> RgbImage {
+    let mut img = RgbImage::from_pixel(PANEL + 4 * CELL, PANEL, Rgb([255, 255, 255]));
     let root = clip.root_path();
-    // Top view.
     let top: Vec<Vec2> = root
         .iter()
         .chain(target)
@@ -37,44 +43,60 @@ pub fn contact_sheet(clip: &Clip, frames: &[usize], target: &[Vec3]) -> RgbImage
         root.iter().map(|p| Vec2::new(p.x, p.z)),
         Rgb([40, 60, 220]),
     );
-    // Side view.
-    let poses: Vec<(usize, Vec<Vec3>)> = frames
+    let chosen: Vec<usize> = frames
         .iter()
-        .filter(|&&f| f < clip.len())
-        .map(|&f| (f, clip.joint_positions(f)))
+        .copied()
+        .filter(|&f| f < clip.len())
+        .take(MAX_FIGURES)
         .collect();
-    let mut pts: Vec<Vec2> = poses
-        .iter()
-        .flat_map(|(_, p)| p.iter().map(|v| Vec2::new(v.x, v.y)))
-        .collect();
-    pts.push(Vec2::ZERO);
-    let fit = Fit::new(&pts, PANEL);
-    let (gx0, gx1) = pts
-        .iter()
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.x), b.max(p.x))
-        });
-    draw_poly(
-        &mut img,
-        &fit,
-        [Vec2::new(gx0, 0.0), Vec2::new(gx1, 0.0)].into_iter(),
-        Rgb([120, 120, 120]),
-    );
-    let n = poses.len().max(1) as f32;
-    for (i, (_, p)) in poses.iter().enumerate() {
-        let s = (i as f32 / n * 180.0) as u8;
+    let n = chosen.len().max(1) as f32;
+    for (k, &f) in chosen.iter().enumerate() {
+        let world = clip.skeleton.forward(&clip.frames[f]);
+        let Some(r) = world.first() else { continue };
+        // Mark the figure's root on the top view.
+        let (mx, my) = fit.px(Vec2::new(r.position.x, r.position.z));
+        for (dx, dy) in [(-2i32, 0i32), (2, 0), (0, -2), (0, 2), (0, 0)] {
+            put(
+                &mut img,
+                mx as i64 + dx as i64,
+                my as i64 + dy as i64,
+                Rgb([0, 0, 0]),
+            );
+        }
+        let fwd = r.rotation * forward;
+        let fwd = Vec2::new(fwd.x, fwd.z).normalize_or(Vec2::X);
+        let base = Vec2::new(r.position.x, r.position.z);
+        let cx = PANEL + (k as u32 % 4) * CELL;
+        let cy = (k as u32 / 4) * CELL;
+        let to_px = |p: Vec3| -> (f32, f32) {
+            let h = (Vec2::new(p.x, p.z) - base).dot(fwd);
+            let scale = CELL as f32 / CELL_SPAN_M;
+            (
+                cx as f32 + CELL as f32 / 2.0 + h * scale,
+                cy as f32 + CELL as f32 - 8.0 - p.y * scale,
+            )
+        };
+        line(
+            &mut img,
+            (cx as f32, to_px(Vec3::ZERO).1),
+            ((cx + CELL - 1) as f32, to_px(Vec3::ZERO).1),
+            Rgb([150, 150, 150]),
+        );
+        let s = (k as f32 / n * 180.0) as u8;
         let color = Rgb([s, s / 2, 255 - s]);
         for (j, joint) in clip.skeleton.joints.iter().enumerate() {
-            if let (Some(par), Some(a)) = (joint.parent, p.get(j)) {
-                if let Some(b) = p.get(par) {
-                    draw_poly(
-                        &mut img,
-                        &fit,
-                        [Vec2::new(a.x, a.y), Vec2::new(b.x, b.y)].into_iter(),
-                        color,
-                    );
+            if let Some(par) = joint.parent {
+                if let (Some(a), Some(b)) = (world.get(j), world.get(par)) {
+                    line(&mut img, to_px(a.position), to_px(b.position), color);
                 }
             }
+        }
+        // Cell frame.
+        for x in cx..cx + CELL {
+            put(&mut img, x as i64, cy as i64, Rgb([220, 220, 220]));
+        }
+        for y in cy..cy + CELL {
+            put(&mut img, cx as i64, y as i64, Rgb([220, 220, 220]));
         }
     }
     img
@@ -85,19 +107,19 @@ pub fn save_contact_sheet(
     clip: &Clip,
     frames: &[usize],
     target: &[Vec3],
+    forward: Vec3,
     path: &Path,
 ) -> anyhow::Result<()> {
-    contact_sheet(clip, frames, target)
+    contact_sheet(clip, frames, target, forward)
         .save(path)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
-/// Maps world 2-D points into one panel, equal scale on both axes, Y up for side views.
+/// Maps world ground points into the top-view panel, equal scale on both axes.
 struct Fit {
     lo: Vec2,
     scale: f32,
     x0: u32,
-    flip_y: bool,
 }
 
 impl Fit {
@@ -118,14 +140,12 @@ impl Fit {
             lo: lo - Vec2::splat(pad),
             scale: (PANEL as f32) / (span + 2.0 * pad),
             x0,
-            flip_y: x0 > 0,
         }
     }
 
     fn px(&self, p: Vec2) -> (f32, f32) {
         let q = (p - self.lo) * self.scale;
-        let y = if self.flip_y { PANEL as f32 - q.y } else { q.y };
-        (self.x0 as f32 + q.x, y)
+        (self.x0 as f32 + q.x, q.y)
     }
 }
 
@@ -151,10 +171,13 @@ fn line(img: &mut RgbImage, a: (f32, f32), b: (f32, f32), color: Rgb<u8>) {
         let x = a.0 + (b.0 - a.0) * t;
         let y = a.1 + (b.1 - a.1) * t;
         for (dx, dy) in [(0, 0), (1, 0), (0, 1)] {
-            let (px, py) = (x as i64 + dx, y as i64 + dy);
-            if px >= 0 && py >= 0 && (px as u32) < img.width() && (py as u32) < img.height() {
-                img.put_pixel(px as u32, py as u32, color);
-            }
+            put(img, x as i64 + dx, y as i64 + dy, color);
         }
+    }
+}
+
+fn put(img: &mut RgbImage, x: i64, y: i64, color: Rgb<u8>) {
+    if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
+        img.put_pixel(x as u32, y as u32, color);
     }
 }
