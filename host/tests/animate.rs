@@ -257,41 +257,46 @@ fn cyclic_walk_plays_whole_cycles_without_skating() {
     if setup().is_none() {
         return;
     }
-    let (log, events) = doodle(
-        &[Seg {
-            action: "walk",
-            dur: 4.0,
-            speed: 0.12,
-            turn: 0.0,
-        }],
-        100.0,
-        3,
-        1.0,
-    );
-    let asm = run(&events, Some(&log));
-    let p = &asm.placements[0];
-    // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles.
-    assert_eq!(p.cycles, 4, "{}", p.path.length());
-    // Planted feet barely slide: horizontal speed of a foot during contact.
-    let legs = figurine_host::anim::contact::find_legs(&asm.clip);
-    let dt = asm.clip.frame_time;
-    let mut slide = Vec::new();
-    for (l, leg) in legs.iter().enumerate() {
-        for f in (p.start_frame + 5)..(p.end_frame - 5) {
-            if asm.contacts[l][f] && asm.contacts[l][f + 1] {
-                let a = asm.clip.joint_positions(f)[leg.ankle];
-                let b = asm.clip.joint_positions(f + 1)[leg.ankle];
-                slide.push(ground(b - a).length() / dt);
+    let seg = [Seg {
+        action: "walk",
+        dur: 4.0,
+        speed: 0.12,
+        turn: 0.0,
+    }];
+    for weight in [0.0, -0.9, 0.9] {
+        let (log, mut events) = doodle(&seg, 100.0, 3, 1.0);
+        events[0].weight = weight;
+        let asm = run(&events, Some(&log));
+        let p = &asm.placements[0];
+        // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles; a light
+        // walk takes shorter strides (more cycles), a strong one longer (fewer).
+        match weight {
+            w if w < 0.0 => assert!(p.cycles > 4, "{}", p.cycles),
+            w if w > 0.0 => assert!(p.cycles < 4, "{}", p.cycles),
+            _ => assert_eq!(p.cycles, 4, "{}", p.path.length()),
+        }
+        // Planted feet barely slide: horizontal ankle speed while in contact.
+        let legs = figurine_host::anim::contact::find_legs(&asm.clip);
+        let dt = asm.clip.frame_time;
+        let mut slide = Vec::new();
+        for (l, leg) in legs.iter().enumerate() {
+            for f in (p.start_frame + 5)..(p.end_frame - 5) {
+                if asm.contacts[l][f] && asm.contacts[l][f + 1] {
+                    let a = asm.clip.joint_positions(f)[leg.ankle];
+                    let b = asm.clip.joint_positions(f + 1)[leg.ankle];
+                    slide.push(ground(b - a).length() / dt);
+                }
             }
         }
+        slide.sort_by(f32::total_cmp);
+        let median = slide[slide.len() / 2];
+        eprintln!(
+            "walk Lw={weight}: {} cycles, contact frames {}, median planted-foot speed {median:.3} m/s",
+            p.cycles,
+            slide.len()
+        );
+        assert!(slide.len() > 20 && median < 0.25, "{median}");
     }
-    slide.sort_by(f32::total_cmp);
-    let median = slide[slide.len() / 2];
-    eprintln!(
-        "contact frames {}, median planted-foot speed {median:.3} m/s",
-        slide.len()
-    );
-    assert!(slide.len() > 20 && median < 0.25, "{median}");
 }
 
 fn single(action: &str, time: f64, weight: f64) -> Assembly {
@@ -338,31 +343,39 @@ fn strong_moves_wider_and_bends_lower_than_light() {
     for action in ["punch", "kick", "wave", "bow"] {
         let light = single(action, 0.0, -0.9);
         let strong = single(action, 0.0, 0.9);
-        // Amplitude: mean distance of the wrists and ankles from their start-of-action position.
+        // Amplitude: mean angle (rad) by which the arms' and legs' joints turn away from
+        // their pose at the action's start — what eq. 7 scales. (Positions would mix in the
+        // foot pinning, which holds planted feet whatever the amplitude.)
         let amp = |a: &Assembly| {
             let sk = &a.clip.skeleton;
-            let ends: Vec<usize> = ["right_wrist", "left_wrist", "right_ankle", "left_ankle"]
-                .iter()
-                .filter_map(|n| sk.find(n))
-                .collect();
-            let p0 = a.clip.joint_positions(a.placements[0].start_frame);
-            let r0 = p0[0];
+            let joints: Vec<usize> = [
+                "right_shoulder",
+                "right_elbow",
+                "left_shoulder",
+                "left_elbow",
+                "right_hip",
+                "right_knee",
+                "left_hip",
+                "left_knee",
+            ]
+            .iter()
+            .filter_map(|n| sk.find(n))
+            .collect();
+            let (s0, e0) = (a.placements[0].start_frame, a.placements[0].end_frame);
+            let q0 = &a.clip.frames[s0].rotations;
             let mut sum = 0.0;
-            let mut n = 0;
-            for f in a.placements[0].start_frame..=a.placements[0].end_frame {
-                let p = a.clip.joint_positions(f);
-                for &j in &ends {
-                    sum += ((p[j] - p[0]) - (p0[j] - r0)).length();
-                    n += 1;
+            for f in s0..=e0 {
+                for &j in &joints {
+                    sum += q0[j].angle_between(a.clip.frames[f].rotations[j]);
                 }
             }
-            sum / n as f32
+            sum / ((e0 - s0 + 1) * joints.len()) as f32
         };
         // Spine angle at the action's first frame, where rescaling (eq. 7, anchored at the
         // stage start) has not acted yet, so the difference is the reshaping's alone.
         let tilt = |a: &Assembly| spine_lean(&a.clip, a.placements[0].start_frame, Vec3::X);
         eprintln!(
-            "{action}: amplitude light {:.3} strong {:.3} m; forward spine lean light {:.1}° strong {:.1}°",
+            "{action}: amplitude light {:.3} strong {:.3} rad; forward spine lean light {:.1}° strong {:.1}°",
             amp(&light),
             amp(&strong),
             tilt(&light).to_degrees(),
@@ -545,4 +558,35 @@ fn random_synthetic_doodles_animate_within_bounds() {
             lowest_foot(&asm)
         );
     }
+}
+
+#[test]
+fn a_jump_travels_only_while_in_the_air() {
+    if setup().is_none() {
+        return;
+    }
+    let (log, events) = doodle(
+        &[Seg {
+            action: "jump",
+            dur: 1.8,
+            speed: 0.1,
+            turn: 0.0,
+        }],
+        100.0,
+        9,
+        1.0,
+    );
+    let asm = run(&events, Some(&log));
+    let p = &asm.placements[0];
+    let n = p.end_frame - p.start_frame;
+    let root = |f: usize| ground(asm.clip.frames[f].translations[0]);
+    // DeepMimic's jump crouches for its first ~35 % and lands in its last ~20 %.
+    let take_off = p.start_frame + n * 30 / 100;
+    let landed = p.end_frame - n * 15 / 100;
+    let before = (root(take_off) - root(p.start_frame)).length();
+    let after = (root(p.end_frame) - root(landed)).length();
+    let flight = (root(landed) - root(take_off)).length();
+    eprintln!("jump: path {:.2} m; root moves {before:.3} m before take-off, {flight:.2} m in the air, {after:.3} m after landing", p.path.length());
+    assert!(before < 0.1 && after < 0.1, "{before} {after}");
+    assert!(flight > 0.8 * p.path.length(), "{flight}");
 }

@@ -17,13 +17,15 @@
 //! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
-//! Finally ground penetration is removed with two-bone IK and foot contacts are reported.
+//! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted
+//! foot where its contact began, undoing slides from rescaling, path stretching and blends),
+//! and ground penetration is removed with two-bone IK.
 
 use std::collections::BTreeMap;
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::contact::{detect_contacts, find_legs, fix_ground, GroundFix};
+use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
 use super::effort::{apply_effort, Effort, EffortClip};
 use super::library::ActionClip;
 use super::phrasing::{detect_stages, Phrasing, Stage};
@@ -90,7 +92,8 @@ pub struct Assembly {
     pub clip: Clip,
     /// One placement per assembled event.
     pub placements: Vec<Placement>,
-    /// Per leg, per frame foot contact.
+    /// Per leg, per frame: the foot is planted (from the source clips' contacts at the frames'
+    /// source times), and was pinned there.
     pub contacts: Vec<Vec<bool>>,
     /// The ground pass's report.
     pub ground: GroundFix,
@@ -105,11 +108,20 @@ pub struct Assembly {
 struct Placed {
     f0: usize,
     poses: Vec<Pose>,
+    /// Per frame, per leg: the source clip's foot contact at the frame's source time.
+    contacts: Vec<Vec<bool>>,
 }
 
 impl Placed {
     fn f1(&self) -> usize {
         self.f0 + self.poses.len().saturating_sub(1)
+    }
+
+    fn contact_at(&self, f: usize) -> Vec<bool> {
+        let k = f
+            .saturating_sub(self.f0)
+            .min(self.contacts.len().saturating_sub(1));
+        self.contacts.get(k).cloned().unwrap_or_default()
     }
 
     fn at(&self, f: usize) -> &Pose {
@@ -186,6 +198,12 @@ pub fn assemble(
         .map(|c| c.clip.skeleton.clone())
         .unwrap_or_default();
     let mut phrasings: BTreeMap<String, Phrasing> = BTreeMap::new();
+    let mut source_contacts: BTreeMap<String, Vec<Vec<bool>>> = BTreeMap::new();
+    let legs = clips
+        .values()
+        .next()
+        .map(|c| find_legs(&c.clip))
+        .unwrap_or_default();
     let mut cursor = Cursor {
         pos: Vec2::ZERO,
         heading: initial_heading(doodle),
@@ -219,15 +237,29 @@ pub fn assemble(
             time: ev.time as f32,
             weight: ev.weight as f32,
         };
-        let ec = apply_effort(&ac.clip, &phrasing, effort, forward);
+        let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
         let duration = (f1 - f0) as f32 / fps;
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
             None => natural_path(ac, duration),
         };
-        let (poses, world_path, cycles) =
+        let (poses, world_path, cycles, src_times) =
             place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0);
+        let src_contacts = source_contacts
+            .entry(ev.action.clone())
+            .or_insert_with(|| detect_contacts(&ac.clip, &legs))
+            .clone();
+        let contacts = src_times
+            .iter()
+            .map(|&t| {
+                let k = (t / ac.clip.frame_time.max(1e-6)).round().max(0.0) as usize;
+                src_contacts
+                    .iter()
+                    .map(|leg| leg.get(k).copied().unwrap_or(false))
+                    .collect()
+            })
+            .collect();
         let stages = ec
             .phrasing
             .spans
@@ -247,7 +279,11 @@ pub fn assemble(
             cycles,
             stages,
         });
-        placed.push(Placed { f0, poses });
+        placed.push(Placed {
+            f0,
+            poses,
+            contacts,
+        });
         last_f1 = f1;
     }
 
@@ -291,25 +327,36 @@ pub fn assemble(
         cuts.push((i, j));
     }
     let mut frames = Vec::with_capacity(total + 1);
+    let mut contact_frames: Vec<Vec<bool>> = Vec::with_capacity(total + 1);
     for f in 0..=total {
         // Which placed action owns frame f, or which transition covers it.
         let mut pose = placed[0].at(f).clone();
+        let mut contact = placed[0].contact_at(f);
         for (k, p) in placed.iter().enumerate() {
             let start_cut = if k == 0 { 0 } else { cuts[k - 1].1 };
             let end_cut = cuts.get(k).map(|c| c.0).unwrap_or(usize::MAX);
             if f >= start_cut && f <= end_cut {
                 pose = p.at(f).clone();
+                contact = p.contact_at(f);
                 break;
             }
             if let (Some(&(i, j)), Some(next)) = (cuts.get(k), placed.get(k + 1)) {
                 if f > i && f < j {
                     let u = smoothstep((f - i) as f32 / (j - i) as f32);
                     pose = blend_world(p.at(f), next.at(f), u);
+                    // A blended foot is planted only if both sides plant it.
+                    contact = p
+                        .contact_at(f)
+                        .iter()
+                        .zip(next.contact_at(f))
+                        .map(|(a, b)| *a && b)
+                        .collect();
                     break;
                 }
             }
         }
         frames.push(pose);
+        contact_frames.push(contact);
     }
     let mut clip = Clip {
         name: "figurine".into(),
@@ -317,9 +364,17 @@ pub fn assemble(
         frame_time: 1.0 / fps,
         frames,
     };
-    let legs = find_legs(&clip);
+    // Per leg, per frame.
+    let contacts: Vec<Vec<bool>> = (0..legs.len())
+        .map(|l| {
+            contact_frames
+                .iter()
+                .map(|c| c.get(l).copied().unwrap_or(false))
+                .collect()
+        })
+        .collect();
+    pin_feet(&mut clip, &legs, &contacts);
     let ground = fix_ground(&mut clip, &legs);
-    let contacts = detect_contacts(&clip, &legs);
     Ok(Assembly {
         clip,
         placements,
@@ -370,7 +425,7 @@ fn natural_path(ac: &ActionClip, duration: f32) -> Polyline {
 }
 
 /// Places one action on `n + 1` output frames; returns the poses (root in world), the world
-/// path it followed, and the number of cycles. Updates the cursor.
+/// path it followed, the number of cycles and each frame's source time (s). Updates the cursor.
 fn place_action(
     ac: &ActionClip,
     ec: &EffortClip,
@@ -378,7 +433,7 @@ fn place_action(
     cursor: &mut Cursor,
     forward: Vec3,
     n: usize,
-) -> (Vec<Pose>, Polyline, usize) {
+) -> (Vec<Pose>, Polyline, usize, Vec<f32>) {
     let clip = &ec.clip;
     let src_root = clip.root_path();
     let r0 = src_root.first().copied().unwrap_or(Vec3::ZERO);
@@ -433,6 +488,7 @@ fn place_action(
     let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
     let mut sigma_max = 0.0f32;
     let mut poses = Vec::with_capacity(n + 1);
+    let mut src_times = Vec::with_capacity(n + 1);
     for k in 0..=n {
         let u = k as f32 / n.max(1) as f32;
         let (w, cycle) = if ac.cyclic {
@@ -442,7 +498,9 @@ fn place_action(
         } else {
             (u, 0)
         };
-        let mut pose = ec.pose(w);
+        let src_t = ec.source_time(w);
+        src_times.push(src_t);
+        let mut pose = ec.clip.sample(src_t);
         let r = pose.translations[0];
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
@@ -490,7 +548,7 @@ fn place_action(
             cursor.heading = f.normalize();
         }
     }
-    (poses, world_path, cycles)
+    (poses, world_path, cycles, src_times)
 }
 
 /// Rotates a ground vector by a yaw quaternion.
