@@ -37,7 +37,7 @@ use crate::motion::{Clip, Pose};
 use crate::poselog::PoseLog;
 
 /// Fastest playback of a clip relative to its own speed (before effort retiming).
-pub const MAX_SPEEDUP: f32 = 2.5;
+pub const MAX_SPEEDUP: f32 = 3.0;
 
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -219,10 +219,6 @@ pub fn assemble(
         if !placed.is_empty() && f0 < last_f1 {
             f0 = last_f1; // overlapping events: the later one starts when the earlier ends
         }
-        // Never faster than MAX_SPEEDUP × the clip: a too-short event overruns into the pause
-        // after it (the next action waits if it must).
-        let min_len = (ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
-        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
         let phrasing = phrasings
             .entry(ev.action.clone())
             .or_insert_with(|| {
@@ -238,14 +234,19 @@ pub fn assemble(
             weight: ev.weight as f32,
         };
         let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
-        let duration = (f1 - f0) as f32 / fps;
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
-            None => natural_path(ac, duration),
+            None => natural_path(ac, (ev.end - ev.start) as f32),
         };
+        // Never faster than MAX_SPEEDUP × the clip (all its cycles): a too-short event overruns
+        // into the pause after it (the next action waits if it must).
+        let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
+        let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
+        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        let duration = (f1 - f0) as f32 / fps;
         let (poses, world_path, cycles, src_times) =
-            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0);
+            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
         let src_contacts = source_contacts
             .entry(ev.action.clone())
             .or_insert_with(|| detect_contacts(&ac.clip, &legs))
@@ -424,7 +425,7 @@ fn natural_path(ac: &ActionClip, duration: f32) -> Polyline {
     Polyline::new(vec![Vec2::ZERO, Vec2::new(len, 0.0)])
 }
 
-/// Places one action on `n + 1` output frames; returns the poses (root in world), the world
+/// Places one action on `n + 1` output frames, playing `cycles` cycles; returns the poses (root in world), the world
 /// path it followed, the number of cycles and each frame's source time (s). Updates the cursor.
 fn place_action(
     ac: &ActionClip,
@@ -433,6 +434,7 @@ fn place_action(
     cursor: &mut Cursor,
     forward: Vec3,
     n: usize,
+    cycles: usize,
 ) -> (Vec<Pose>, Polyline, usize, Vec<f32>) {
     let clip = &ec.clip;
     let src_root = clip.root_path();
@@ -467,11 +469,6 @@ fn place_action(
     let r_start = yaw_between(clip_dir, start_heading);
     let base = cursor.pos;
     let cycle_len = along(rl - r0);
-    let cycles = if ac.cyclic && moving && cycle_len > 0.05 {
-        ((chunk.length() / cycle_len).round() as usize).max(1)
-    } else {
-        1
-    };
     let stretch = if cycles > 0 && cycle_len > 0.05 {
         chunk.length() / (cycles as f32 * cycle_len)
     } else {
@@ -549,6 +546,24 @@ fn place_action(
         }
     }
     (poses, world_path, cycles, src_times)
+}
+
+/// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
+/// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
+/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put); 1 otherwise.
+fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
+    let root = ec.clip.root_path();
+    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
+        return 1;
+    };
+    let cycle_len = ground(rl - r0).length();
+    if ac.cyclic && ac.moving && chunk.length() > 0.05 && cycle_len > 0.05 {
+        let by_path = (chunk.length() / cycle_len).round() as usize;
+        let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
+        by_path.min(by_time).max(1)
+    } else {
+        1
+    }
 }
 
 /// Rotates a ground vector by a yaw quaternion.

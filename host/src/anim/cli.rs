@@ -107,6 +107,27 @@ pub enum ClipCommand {
         #[arg(long)]
         urdf: Option<PathBuf>,
     },
+    /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
+    /// to a PNG.
+    Plot {
+        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        clip: String,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        /// Clip library to look action names up in (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// URDF for DeepMimic files (default: the data folder's humanoid.urdf).
+        #[arg(long)]
+        urdf: Option<PathBuf>,
+        /// Length unit → metres (e.g. 0.01 for centimetre BVH).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f32,
+        /// The rig's facing direction in its clips, x,y,z (DeepMimic: 1,0,0).
+        #[arg(long, default_value = "1,0,0")]
+        forward: String,
+    },
 }
 
 /// Runs `figurine animate`.
@@ -294,6 +315,33 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
                     s.end as f32 * c.frame_time
                 );
             }
+            Ok(())
+        }
+        ClipCommand::Plot {
+            clip,
+            out,
+            clips,
+            urdf,
+            scale,
+            forward,
+        } => {
+            let (mut c, _) = load_named_clip(clip, clips.as_deref(), urdf.as_deref())?;
+            c.scale_lengths(*scale);
+            let f: Vec<f32> = forward
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--forward {forward:?}: expected x,y,z"))?;
+            let fwd = match f.as_slice() {
+                [x, y, z] => glam::Vec3::new(*x, *y, *z),
+                _ => bail!("--forward {forward:?}: expected three numbers"),
+            };
+            let n = super::plot::MAX_FIGURES;
+            let frames: Vec<usize> = (0..n)
+                .map(|k| (k * c.len().saturating_sub(1)) / (n - 1))
+                .collect();
+            save_contact_sheet(&c, &frames, &[], fwd, out)?;
+            println!("{}: {} figures of {}", out.display(), n, c.name);
             Ok(())
         }
     }

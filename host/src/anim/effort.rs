@@ -270,14 +270,28 @@ pub fn joint_speeds(clip: &Clip) -> Vec<f32> {
         .collect()
 }
 
-/// `q^c` for a unit quaternion along the shorter arc (any real c).
+/// Largest joint rotation (radians) away from the stage-start pose that rescaling may
+/// produce: amplifying a large swing past this would wrap round and flip the limb.
+pub const MAX_RESCALED_ANGLE: f32 = 2.6;
+
+/// `q^c` for a unit quaternion along the shorter arc (any real c), the result's angle capped
+/// at [`MAX_RESCALED_ANGLE`] when amplifying.
 fn quat_pow(q: Quat, c: f32) -> Quat {
     let q = if q.w < 0.0 { -q } else { q };
     let (axis, angle) = q.normalize().to_axis_angle();
     if angle.abs() < 1e-7 || !axis.is_finite() {
         return Quat::IDENTITY;
     }
-    Quat::from_axis_angle(axis, angle * c)
+    let scaled = angle * c;
+    let scaled = if c > 1.0 {
+        scaled.clamp(
+            -MAX_RESCALED_ANGLE.max(angle.abs()),
+            MAX_RESCALED_ANGLE.max(angle.abs()),
+        )
+    } else {
+        scaled
+    };
+    Quat::from_axis_angle(axis, scaled)
 }
 
 /// Eq. 7 per stage, references chained so the result is continuous.
