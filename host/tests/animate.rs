@@ -590,3 +590,113 @@ fn a_jump_travels_only_while_in_the_air() {
     assert!(before < 0.1 && after < 0.1, "{before} {after}");
     assert!(flight > 0.8 * p.path.length(), "{flight}");
 }
+
+#[test]
+fn unordered_overlapping_events_and_degenerate_doodles_still_animate() {
+    if setup().is_none() {
+        return;
+    }
+    let ev = |action: &str, start: f64, end: f64| ActionRecord {
+        action: action.into(),
+        start,
+        end,
+        time: f64::NAN,
+        weight: 3.0,
+        distance: 0,
+    };
+    // Out of order, overlapping, one with an absurd effort: sorted, chained, clamped.
+    let events = vec![
+        ev("kick", 2.0, 3.0),
+        ev("walk", 0.0, 2.5),
+        ev("punch", 2.9, 3.1),
+    ];
+    let one_sample = PoseLog {
+        samples: vec![PoseSample {
+            t: 0.0,
+            pos: [0.0, 1.0, 0.0],
+            quat: [1.0, 0.0, 0.0, 0.0],
+        }],
+    };
+    for log in [None, Some(&one_sample), Some(&PoseLog::default())] {
+        let asm = run(&events, log);
+        let names: Vec<&str> = asm.placements.iter().map(|p| p.action.as_str()).collect();
+        assert_eq!(names, ["walk", "kick", "punch"]);
+        for w in asm.placements.windows(2) {
+            assert!(
+                w[1].start_frame >= w[0].end_frame,
+                "{} overlaps {}",
+                w[1].action,
+                w[0].action
+            );
+        }
+        assert!(asm
+            .clip
+            .frames
+            .iter()
+            .all(|p| p.translations.iter().all(|t| t.is_finite())));
+        assert!(lowest_foot(&asm) >= -1e-3);
+    }
+}
+
+#[test]
+fn cli_reports_malformed_inputs_with_file_and_line() {
+    let dir = out_dir();
+    let bad_events = dir.join("bad_events.jsonl");
+    std::fs::write(
+        &bad_events,
+        "{\"action\":\"walk\",\"start\":0,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}\n{\"action\":\"walk\",\"start\":\n",
+    )
+    .unwrap();
+    let bad_lib = dir.join("bad_clips.json");
+    std::fs::write(
+        &bad_lib,
+        "{\n  \"version\": 1,\n  \"actions\": {\n    \"walk\": { \"file\": }\n  }\n}\n",
+    )
+    .unwrap();
+    let good_events = dir.join("good_events.jsonl");
+    std::fs::write(
+        &good_events,
+        "{\"action\":\"walk\",\"start\":0,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}\n",
+    )
+    .unwrap();
+    let bad_log = dir.join("bad_doodle.csv");
+    std::fs::write(
+        &bad_log,
+        "t,x,y,z,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.1,zero,0,0,1,0,0,0\n",
+    )
+    .unwrap();
+    let cases: [(Vec<&std::ffi::OsStr>, String); 3] = [
+        (
+            vec![bad_events.as_os_str()],
+            format!("{}:2:", bad_events.display()),
+        ),
+        (
+            vec![
+                good_events.as_os_str(),
+                "--clips".as_ref(),
+                bad_lib.as_os_str(),
+            ],
+            format!("{}:4:", bad_lib.display()),
+        ),
+        (
+            vec![
+                good_events.as_os_str(),
+                "--doodle".as_ref(),
+                bad_log.as_os_str(),
+            ],
+            format!("{}:3:", bad_log.display()),
+        ),
+    ];
+    for (args, expect) in cases {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_figurine"))
+            .args(["animate", "--out"])
+            .arg(dir.join("never.bvh"))
+            .arg("--events")
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(err.contains(&expect), "expected {expect} in: {err}");
+    }
+}
