@@ -5,6 +5,9 @@
 pub mod anim;
 pub mod data;
 pub mod events;
+pub mod link;
 pub mod motion;
 pub mod poselog;
+pub mod recognize;
+pub mod render;
 pub mod synth;
