@@ -700,3 +700,71 @@ fn cli_reports_malformed_inputs_with_file_and_line() {
         assert!(err.contains(&expect), "expected {expect} in: {err}");
     }
 }
+
+#[test]
+fn animate_recognises_a_log_itself() {
+    if setup().is_none() {
+        return;
+    }
+    let exe = env!("CARGO_BIN_EXE_figurine");
+    let dir = out_dir().join("log_mode");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run_ok = |args: &[&std::ffi::OsStr]| {
+        let out = std::process::Command::new(exe).args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{:?}: {}",
+            args,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let ex = dir.join("ex");
+    let lib = dir.join("lib.json");
+    let log = dir.join("jump.csv");
+    let bvh = dir.join("jump.bvh");
+    run_ok(&[
+        "synth".as_ref(),
+        "examples".as_ref(),
+        "--action".as_ref(),
+        "jump".as_ref(),
+        "--seed".as_ref(),
+        "1".as_ref(),
+        "--out".as_ref(),
+        ex.as_os_str(),
+    ]);
+    let mut learn: Vec<std::ffi::OsString> = vec![
+        "learn".into(),
+        "--library".into(),
+        lib.clone().into(),
+        "--name".into(),
+        "jump".into(),
+    ];
+    for k in 1..=3 {
+        learn.push(ex.join(format!("jump_{k}.csv")).into());
+    }
+    run_ok(&learn.iter().map(|s| s.as_os_str()).collect::<Vec<_>>());
+    run_ok(&[
+        "synth".as_ref(),
+        "gesture".as_ref(),
+        "--action".as_ref(),
+        "jump".as_ref(),
+        "--seed".as_ref(),
+        "4".as_ref(),
+        "--out".as_ref(),
+        log.as_os_str(),
+    ]);
+    let stdout = run_ok(&[
+        "animate".as_ref(),
+        "--library".as_ref(),
+        lib.as_os_str(),
+        log.as_os_str(),
+        "--out".as_ref(),
+        bvh.as_os_str(),
+    ]);
+    eprintln!("{stdout}");
+    assert!(stdout.contains("jump"), "{stdout}");
+    let clip = figurine_host::motion::read_bvh_path(&bvh).unwrap().clip;
+    assert!(clip.len() > 30);
+}
