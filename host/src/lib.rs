@@ -2,6 +2,7 @@
 //!
 //! Modules are named after their stage in the data flow (see DESIGN.md).
 
+pub mod anim;
 pub mod data;
 pub mod events;
 pub mod link;

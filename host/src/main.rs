@@ -15,6 +15,10 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Assemble a character animation (BVH, optional .glb) from actions and the doodle.
+    Animate(figurine_host::anim::cli::AnimateArgs),
+    /// Inspect motion clips (`clip stages CLIP`).
+    Clip(figurine_host::anim::cli::ClipArgs),
     /// Learn (or replace) an action's pattern from example pose logs.
     Learn(figurine_host::recognize::learn::LearnArgs),
     /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
@@ -44,6 +48,8 @@ enum Command {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Animate(a) => figurine_host::anim::cli::run_animate(&a)?,
+        Command::Clip(a) => figurine_host::anim::cli::run_clip(&a)?,
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }

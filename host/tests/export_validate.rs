@@ -18,6 +18,29 @@ fn tmp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// A whole assembled animation: a synthetic doodle of four actions with its true labels.
+fn assembled() -> Clip {
+    use figurine_host::anim::assemble::{assemble, AssembleOptions};
+    use figurine_host::anim::library::ClipLibrary;
+    let d = figurine_host::synth::sequence::sequence(5, &Default::default(), 4, None);
+    let labels = tmp("labels.json");
+    std::fs::write(&labels, serde_json::to_string(&d.labels).unwrap()).unwrap();
+    let events = figurine_host::anim::cli::read_label_events(&labels).unwrap();
+    let lib = ClipLibrary::default_library().unwrap();
+    let clips = lib.load(events.iter().map(|e| e.action.as_str())).unwrap();
+    let mut clip = assemble(
+        &events,
+        Some(&d.log),
+        &clips,
+        lib.forward(),
+        &AssembleOptions::default(),
+    )
+    .unwrap()
+    .clip;
+    clip.name = "assembled".into();
+    clip
+}
+
 fn clips() -> Vec<(Clip, f32)> {
     let mut out = Vec::new();
     if let (Some(walk), Some(urdf)) = (
@@ -25,6 +48,7 @@ fn clips() -> Vec<(Clip, f32)> {
         data_file("deepmimic", "humanoid.urdf"),
     ) {
         out.push((read_deepmimic_path(&walk, &urdf).unwrap().clip, 1.0));
+        out.push((assembled(), 1.0));
     }
     for (name, scale) in [
         ("blender_gestures.bvh", 1.0),
