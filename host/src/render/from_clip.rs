@@ -340,7 +340,7 @@ pub fn scene_from_clip(clip: &Clip) -> Scene {
             }
             FramePose {
                 segments,
-                facing: facing(&pts, &plan.left, &plan.right),
+                facing: facing(pts, &plan.left, &plan.right),
             }
         })
         .collect();

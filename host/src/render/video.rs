@@ -80,7 +80,7 @@ pub fn gif_delay_cs(fps: f32) -> u16 {
 /// Times (seconds) of the frames of a `duration`-second clip at `fps`: 0, 1/fps, … up to the
 /// last frame not after the end; always at least one frame.
 pub fn frame_times(duration: f32, fps: f32) -> Vec<f32> {
-    if !(fps.is_finite() && fps > 0.0) || !duration.is_finite() || duration <= 0.0 {
+    if !(fps.is_finite() && fps > 0.0 && duration.is_finite() && duration > 0.0) {
         return vec![0.0];
     }
     let n = (duration * fps + 1e-3).floor() as usize + 1;

@@ -336,15 +336,8 @@ impl App {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("view"),
             });
-        g.renderer.draw(
-            &g.gpu.device,
-            &g.gpu.queue,
-            &mut encoder,
-            &g.attachments.msaa,
-            &view,
-            &g.attachments.depth,
-            &draw,
-        );
+        g.renderer
+            .draw(&g.gpu, &mut encoder, &g.attachments, &view, &draw);
         g.gpu.queue.submit([encoder.finish()]);
         g.window.pre_present_notify();
         g.gpu.queue.present(frame);
