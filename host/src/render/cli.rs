@@ -140,12 +140,25 @@ pub struct ViewArgs {
     /// Initial window size in pixels, `WxH`.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
+    /// Close the window by itself after this many seconds (smoke tests, timed demos).
+    #[arg(long)]
+    pub quit_after: Option<f32>,
 }
 
 /// Runs `figurine view` (blocks until the window closes).
 pub fn run_view(args: &ViewArgs) -> anyhow::Result<()> {
     let scene = args.scene.load()?;
-    super::viewer::run_viewer(super::viewer::ViewerSource::Clip(scene), args.size)?;
+    let quit_after = match args.quit_after {
+        Some(s) if s.is_finite() && s >= 0.0 => Some(std::time::Duration::from_secs_f32(s)),
+        Some(s) => anyhow::bail!("--quit-after must be a non-negative number of seconds, got {s}"),
+        None => None,
+    };
+    let opts = super::viewer::ViewerOptions {
+        size: args.size,
+        quit_after,
+    };
+    let report = super::viewer::run_viewer(super::viewer::ViewerSource::Clip(scene), opts)?;
+    eprintln!("figurine view: {} frames presented", report.frames);
     Ok(())
 }
 
