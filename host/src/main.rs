@@ -19,16 +19,25 @@ enum Command {
     Render(figurine_host::render::cli::RenderArgs),
     /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
     View(figurine_host::render::cli::ViewArgs),
+    /// Assemble a character animation (BVH, optional .glb) from actions and the doodle.
+    Animate(figurine_host::anim::cli::AnimateArgs),
+    /// Inspect motion clips (`clip stages CLIP`).
+    Clip(figurine_host::anim::cli::ClipArgs),
+    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+    Synth(figurine_host::synth::cli::SynthArgs),
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Animate(a) => figurine_host::anim::cli::run_animate(&a)?,
+        Command::Clip(a) => figurine_host::anim::cli::run_clip(&a)?,
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
         Command::Render(args) => figurine_host::render::cli::run_render(&args)?,
         Command::View(args) => figurine_host::render::cli::run_view(&args)?,
+        Command::Synth(args) => figurine_host::synth::cli::run(args)?,
     }
     Ok(())
 }

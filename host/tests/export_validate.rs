@@ -18,6 +18,29 @@ fn tmp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// A whole assembled animation: a synthetic doodle of four actions with its true labels.
+fn assembled() -> Clip {
+    use figurine_host::anim::assemble::{assemble, AssembleOptions};
+    use figurine_host::anim::library::ClipLibrary;
+    let d = figurine_host::synth::sequence::sequence(5, &Default::default(), 4, None);
+    let labels = tmp("labels.json");
+    std::fs::write(&labels, serde_json::to_string(&d.labels).unwrap()).unwrap();
+    let events = figurine_host::anim::cli::read_label_events(&labels).unwrap();
+    let lib = ClipLibrary::default_library().unwrap();
+    let clips = lib.load(events.iter().map(|e| e.action.as_str())).unwrap();
+    let mut clip = assemble(
+        &events,
+        Some(&d.log),
+        &clips,
+        lib.forward(),
+        &AssembleOptions::default(),
+    )
+    .unwrap()
+    .clip;
+    clip.name = "assembled".into();
+    clip
+}
+
 fn clips() -> Vec<(Clip, f32)> {
     let mut out = Vec::new();
     if let (Some(walk), Some(urdf)) = (
@@ -25,6 +48,7 @@ fn clips() -> Vec<(Clip, f32)> {
         data_file("deepmimic", "humanoid.urdf"),
     ) {
         out.push((read_deepmimic_path(&walk, &urdf).unwrap().clip, 1.0));
+        out.push((assembled(), 1.0));
     }
     for (name, scale) in [
         ("blender_gestures.bvh", 1.0),
@@ -43,8 +67,20 @@ fn clips() -> Vec<(Clip, f32)> {
     out
 }
 
+/// The Python that `cargo xtask setup` prepared (a venv with `bvh`), else `python3`.
+fn python() -> PathBuf {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/tools/pyenv/bin/python");
+    std::env::var_os("FIGURINE_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or(if venv.exists() {
+            venv
+        } else {
+            PathBuf::from("python3")
+        })
+}
+
 fn python_has_bvh() -> bool {
-    Command::new("python3")
+    Command::new(python())
         .args(["-c", "import bvh"])
         .output()
         .map(|o| o.status.success())
@@ -70,7 +106,7 @@ first = [float(x) for x in m.frames[0]]
 print(json.dumps({"nframes": m.nframes, "frame_time": m.frame_time, "names": names,
                   "nvalues": len(first), "first": first}))
 "#;
-        let out = Command::new("python3")
+        let out = Command::new(python())
             .arg("-c")
             .arg(script)
             .arg(&path)
@@ -115,6 +151,7 @@ print(json.dumps({"nframes": m.nframes, "frame_time": m.frame_time, "names": nam
 fn validator_dir() -> Option<PathBuf> {
     let candidates = [
         std::env::var_os("GLTF_VALIDATOR_NODE_PATH").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/tools/node/node_modules")),
         Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/npm/node_modules")),
     ];
     candidates

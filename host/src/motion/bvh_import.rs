@@ -15,6 +15,9 @@ use super::clip::{Clip, Pose};
 use super::skeleton::{Axis, Channel, Joint, RotationOrder, Skeleton};
 use super::MotionError;
 
+/// Deepest joint nesting accepted (real rigs have < 20 levels; the parser recurses per level).
+pub const MAX_DEPTH: usize = 256;
+
 /// The result of importing a BVH file.
 #[derive(Debug, Clone)]
 pub struct BvhImport {
@@ -257,6 +260,16 @@ impl Parser<'_> {
         }
     }
 
+    fn depth_of(&self, j: usize) -> usize {
+        let mut d = 0;
+        let mut cur = self.joints.get(j).and_then(|x| x.joint.parent);
+        while let Some(p) = cur {
+            d += 1;
+            cur = self.joints.get(p).and_then(|x| x.joint.parent);
+        }
+        d
+    }
+
     fn unique_name(&self, base: &str) -> String {
         let taken = |n: &str| self.joints.iter().any(|j| j.joint.name == n);
         if !taken(base) {
@@ -269,6 +282,10 @@ impl Parser<'_> {
     }
 
     fn parse_joint(&mut self, parent: Option<usize>) -> Result<(), MotionError> {
+        let depth = parent.map_or(0, |p| self.depth_of(p) + 1);
+        if depth > MAX_DEPTH {
+            return Err(self.err(format!("joints nested deeper than {MAX_DEPTH}")));
+        }
         let mut name_toks = self.rest_of_line();
         let brace_on_line = name_toks.last().map(|t| t == "{").unwrap_or(false);
         if brace_on_line {
@@ -501,6 +518,14 @@ mod tests {
             assert!(err.starts_with(&format!("bad.bvh:{line}:")), "{err}");
         }
         assert!(read_bvh("", Path::new("e.bvh")).is_err());
+        let deep = format!(
+            "HIERARCHY\nROOT a\n{{\nOFFSET 0 0 0\nCHANNELS 0\n{}",
+            "JOINT b\n{\nOFFSET 0 0 0\nCHANNELS 0\n".repeat(100_000)
+        );
+        let err = read_bvh(&deep, Path::new("deep.bvh"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("nested deeper"), "{err}");
         assert!(read_bvh("HIERARCHY\nMOTION\n", Path::new("e.bvh")).is_err());
         let cut = &SMALL[..SMALL.find("MOTION").unwrap_or(0)];
         assert!(read_bvh(cut, Path::new("e.bvh")).is_err());

@@ -166,6 +166,11 @@ pub fn read_deepmimic(
     skeleton: &Skeleton,
     urdf: &[UrdfJoint],
 ) -> Result<DeepMimicClip, MotionError> {
+    if skeleton.is_empty() {
+        return Err(MotionError::Invalid(
+            "DeepMimic clips need the humanoid skeleton (it is empty)".into(),
+        ));
+    }
     let v: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| MotionError::parse(path, e.line().max(1), e.to_string()))?;
     let looping = v.get("Loop").and_then(|l| l.as_str()) == Some("wrap");
@@ -357,7 +362,21 @@ mod tests {
 
     #[test]
     fn malformed_json_names_file_and_line() {
-        let sk = Skeleton::default();
+        let urdf_text = "<robot><joint name=\"chest\" type=\"spherical\"><parent link=\"root\"/><child link=\"chest\"/></joint></robot>";
+        let _ = urdf_text;
+        let sk = Skeleton {
+            joints: vec![crate::motion::Joint {
+                name: "root".into(),
+                parent: None,
+                offset: Vec3::ZERO,
+                channels: vec![],
+                rotation_order: RotationOrder::ZYX,
+                end_site: false,
+            }],
+        };
+        let full = format!("{{\"Frames\": [[{}]]}}", vec!["0.1"; 44].join(","));
+        assert!(read_deepmimic(&full, Path::new("c.txt"), &Skeleton::default(), &[]).is_err());
+        assert!(read_deepmimic(&full, Path::new("c.txt"), &sk, &[]).is_err()); // one frame only
         let bad = "{\n\"Loop\": \"none\",\n\"Frames\": [\n[0.1, 1, 2],\n]\n}";
         let e = read_deepmimic(bad, Path::new("c.txt"), &sk, &[])
             .unwrap_err()

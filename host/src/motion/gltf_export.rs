@@ -37,6 +37,11 @@ pub fn write_glb_bytes(clip: &Clip, to_metres: f32) -> Result<Vec<u8>, MotionErr
         )));
     }
     let n = sk.len();
+    if n > usize::from(u16::MAX) {
+        return Err(MotionError::Invalid(format!(
+            "{n} joints: glTF skins here index joints with 16 bits"
+        )));
+    }
     let mut b = Builder::default();
 
     // Rest pose, world positions (scaled).
