@@ -33,7 +33,11 @@ fn main() -> anyhow::Result<()> {
         while Instant::now() < stop {
             let t = start.elapsed().as_secs_f32();
             if t >= next_event {
-                let action = if (next_event as u32) % 2 == 0 { "hop" } else { "walk" };
+                let action = if (next_event as u32) % 2 == 0 {
+                    "hop"
+                } else {
+                    "walk"
+                };
                 producer.push_event(
                     TimelineSpan {
                         action: action.into(),

@@ -50,8 +50,8 @@ fn every_fetched_bvh_renders_a_visible_figure() {
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/render-test");
     let _ = std::fs::create_dir_all(&out_dir);
     for file in &files {
-        let scene =
-            load_scene(file, None, None).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+        let scene = load_scene(file, None, None, 1.0)
+            .unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
         let d = scene.duration();
         for k in 0..SAMPLES {
             let t = d * k as f32 / (SAMPLES - 1) as f32;

@@ -223,7 +223,12 @@ fn bvh_with_doodle_and_events_shows_every_layer() {
     for i in 0..=50 {
         let t = i as f64 / 50.0;
         let y = 0.3 + 0.3 * (std::f64::consts::PI * t).sin();
-        csv.push_str(&format!("{:.4},0.3,{y:.4},{:.4},1,0,0,0\n", 100.0 + t, t * 0.4));
+        csv.push_str(&format!(
+            "{:.4},{:.4},{y:.4},{:.4},1,0,0,0\n",
+            100.0 + t,
+            0.3 + t * 0.8,
+            t * 0.4
+        ));
     }
     let log_path = dir.join("doodle.csv");
     std::fs::write(&log_path, csv).expect("write log");
@@ -234,28 +239,43 @@ fn bvh_with_doodle_and_events_shows_every_layer() {
     )
     .expect("write events");
 
-    let scene = figurine_host::render::from_clip::load_scene(&bvh_path, Some(&log_path), Some(&ev_path))
-        .expect("load scene");
+    let scene = figurine_host::render::from_clip::load_scene(
+        &bvh_path,
+        Some(&log_path),
+        Some(&ev_path),
+        1.0,
+    )
+    .expect("load scene");
     assert_eq!(scene.frames.len(), 3);
     assert_eq!(scene.timeline.len(), 1);
-    assert!((scene.timeline[0].start - 0.1).abs() < 1e-4, "events share the doodle clock");
+    assert!(
+        (scene.timeline[0].start - 0.1).abs() < 1e-4,
+        "events share the doodle clock"
+    );
     assert!(scene.doodle.len() > 40);
     let mut r = OffscreenRenderer::new(320, 180).expect("GPU");
     let img = render_still(&mut r, &scene, 0.5).expect("render");
     let _ = img.save(artefact_dir().join("small_bvh_layers.png"));
     // The timeline block of "jump" shows in its action colour in the bottom rows.
-    let [cr, cg, cb] = figurine_host::render::overlay::action_colour("jump").map(|c| (c * 255.0).round() as i32);
+    let [cr, cg, cb] =
+        figurine_host::render::overlay::action_colour("jump").map(|c| (c * 255.0).round() as i32);
     let bar_hits = img
         .enumerate_pixels()
         .filter(|(_, y, p)| {
-            *y > 150 && (i32::from(p[0]) - cr).abs() < 12 && (i32::from(p[1]) - cg).abs() < 12 && (i32::from(p[2]) - cb).abs() < 12
+            *y > 150
+                && (i32::from(p[0]) - cr).abs() < 12
+                && (i32::from(p[1]) - cg).abs() < 12
+                && (i32::from(p[2]) - cb).abs() < 12
         })
         .count();
-    assert!(bar_hits > 50, "timeline block not drawn ({bar_hits} pixels)");
+    assert!(
+        bar_hits > 50,
+        "timeline block not drawn ({bar_hits} pixels)"
+    );
     // The doodle (magenta-pink) shows above the bar.
     let doodle_hits = img
         .enumerate_pixels()
-        .filter(|(_, y, p)| *y < 140 && p[0] > 150 && p[1] < 90 && p[2] > 70)
+        .filter(|(_, y, p)| *y < 160 && p[0] > 150 && p[1] < 100 && p[2] > 70)
         .count();
     assert!(doodle_hits > 10, "doodle not drawn ({doodle_hits} pixels)");
     assert!(figure_pixels(&img) > 300);
