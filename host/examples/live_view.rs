@@ -33,7 +33,7 @@ fn main() -> anyhow::Result<()> {
         while Instant::now() < stop {
             let t = start.elapsed().as_secs_f32();
             if t >= next_event {
-                let action = if (next_event as u32) % 2 == 0 {
+                let action = if (next_event as u32).is_multiple_of(2) {
                     "hop"
                 } else {
                     "walk"
