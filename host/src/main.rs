@@ -15,6 +15,10 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
+    Render(figurine_host::render::cli::RenderArgs),
+    /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
+    View(figurine_host::render::cli::ViewArgs),
     /// Assemble a character animation (BVH, optional .glb) from actions and the doodle.
     Animate(figurine_host::anim::cli::AnimateArgs),
     /// Inspect motion clips (`clip stages CLIP`).
