@@ -9,7 +9,8 @@ use figurine_host::poselog::{PoseLog, PoseSample};
 /// Reads a TUM (`t tx ty tz qx qy qz qw`, seconds) or EuRoC (`ns,x,y,z,qw,qx,qy,qz,…`)
 /// trajectory; at most `limit` samples.
 pub fn read(path: &Path, limit: usize) -> Result<PoseLog> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let euroc = path.extension().is_some_and(|e| e == "csv");
     let mut samples = Vec::new();
     for (n, line) in text.lines().enumerate() {

@@ -62,7 +62,11 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
         library: lib.blob().expect("library blob"),
         effort: defaults.effort,
     };
-    eprintln!("learnt {} actions in {:.1} s", blobs.names.len(), t.elapsed().as_secs_f64());
+    eprintln!(
+        "learnt {} actions in {:.1} s",
+        blobs.names.len(),
+        t.elapsed().as_secs_f64()
+    );
     let mut q = Qemu::start(&QemuOptions::default()).expect("start QEMU");
     let mut dev = q.connect().expect("connect");
     upload_to(&mut dev, &blobs, true).expect("upload");
@@ -72,9 +76,17 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
     let knobs = Knobs::default();
     for seed in [1u64, 2, 3] {
         let doodle = sequence(seed, &knobs, 4, None);
-        events += check_identical(&mut dev, &blobs, &doodle.log, &format!("synthetic seed {seed}"));
+        events += check_identical(
+            &mut dev,
+            &blobs,
+            &doodle.log,
+            &format!("synthetic seed {seed}"),
+        );
     }
-    assert!(events > 0, "the synthetic sequences produced no events at all");
+    assert!(
+        events > 0,
+        "the synthetic sequences produced no events at all"
+    );
 
     for name in ["tum_fr1_xyz_groundtruth.txt", "euroc_v102_groundtruth.csv"] {
         let Some(path) = data_file("pose6d", name) else {

@@ -66,8 +66,13 @@ impl Blobs {
             let blob = store.active(&mut flash)?;
             match validate(kind, &mut flash, &blob) {
                 Ok(()) => {
-                    defmt::info!("{} loaded: {} bytes, crc {=u32:08x}, generation {}",
-                        kind, blob.header.len, blob.header.crc32, blob.header.generation);
+                    defmt::info!(
+                        "{} loaded: {} bytes, crc {=u32:08x}, generation {}",
+                        kind,
+                        blob.header.len,
+                        blob.header.crc32,
+                        blob.header.generation
+                    );
                     Some(blob)
                 }
                 Err(e) => {
@@ -159,7 +164,9 @@ impl Blobs {
         };
         validate(k, &mut self.flash, &staged)
             .map_err(|e| err(ErrorCode::BlobInvalid, reason(e)))?;
-        let blob = store.commit(&mut self.flash, &up).map_err(|e| store_err(e))?;
+        let blob = store
+            .commit(&mut self.flash, &up)
+            .map_err(|e| store_err(e))?;
         match k {
             BlobKind::Library => self.library = Some(blob),
             BlobKind::Effort => self.effort = Some(blob),

@@ -84,7 +84,11 @@ pub fn init() -> Board {
     let (rx, tx) = uart::init(&mut core.NVIC);
     let cut = fault_from_args();
     if let Some(c) = &cut {
-        defmt::info!("fault injection armed: power cut in upload {} after {} bytes", c.upload, c.after_bytes);
+        defmt::info!(
+            "fault injection armed: power cut in upload {} after {} bytes",
+            c.upload,
+            c.after_bytes
+        );
     }
     Board {
         rx,
