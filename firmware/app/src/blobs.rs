@@ -127,7 +127,7 @@ impl Blobs {
         }
         let up = store_of(b.kind)
             .begin(&mut self.flash, b.len, b.crc32)
-            .map_err(|e| store_err(e))?;
+            .map_err(store_err)?;
         self.upload = Some((b.kind, up));
         Ok(())
     }
@@ -164,9 +164,7 @@ impl Blobs {
         };
         validate(k, &mut self.flash, &staged)
             .map_err(|e| err(ErrorCode::BlobInvalid, reason(e)))?;
-        let blob = store
-            .commit(&mut self.flash, &up)
-            .map_err(|e| store_err(e))?;
+        let blob = store.commit(&mut self.flash, &up).map_err(store_err)?;
         match k {
             BlobKind::Library => self.library = Some(blob),
             BlobKind::Effort => self.effort = Some(blob),

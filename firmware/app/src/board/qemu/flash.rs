@@ -68,6 +68,11 @@ impl Flash {
         }
     }
 
+    /// The power cut still to come, if any.
+    pub fn armed(&self) -> Option<Cut> {
+        self.cut
+    }
+
     fn word_ptr(offset: usize) -> *mut u32 {
         (BASE + offset) as *mut u32
     }
