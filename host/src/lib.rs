@@ -4,5 +4,6 @@
 
 pub mod data;
 pub mod events;
+pub mod graph;
 pub mod motion;
 pub mod poselog;

@@ -15,6 +15,8 @@ struct Cli {
 enum Command {
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
+    /// Style-coherent motion graphs: build, synth, eval (seed 003).
+    Graph(figurine_host::graph::cli::GraphArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -23,6 +25,7 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Graph(args) => figurine_host::graph::cli::run(args)?,
     }
     Ok(())
 }
