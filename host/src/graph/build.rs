@@ -4,8 +4,8 @@
 //! posture distance of eq. 1 needs three cross sums over the windows' 35 × 16 point pairs,
 //! `Σ (x x' + z z')`, `Σ (x z' − z x')`, `Σ y y'`. They are sums along a diagonal of the
 //! frame-pair dot-product matrix, so a tile of T × T window pairs is computed as:
-//! 1. frame-pair dot products for the tile's (T + 36)² frame pairs: a small matrix product with
-//!    16-column register blocks over a structure-of-arrays, f32 (auto-vectorised);
+//! 1. frame-pair dot products for the tile's (T + 36)² frame pairs: three small f32 matrix
+//!    products over a structure-of-arrays layout (matrixmultiply's SIMD kernels);
 //! 2. 35-long diagonal running sums (restarted every [`RESTART`] rows against f32 drift);
 //! 3. the closed form of [`super::posture`] per pair, then 3 × 3 local minima of the distance.
 //!
@@ -20,12 +20,14 @@
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use ndarray::linalg::general_mat_mul;
+use ndarray::{ArrayView2, ArrayViewMut2};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::graph::{ClipEntry, Edge, MotionGraph, GRAPH_VERSION};
 use super::lma::{clip_measurements, MEASUREMENTS};
-use super::posture::{closed_form, window_terms, WindowTerms};
+use super::posture::{window_terms, WindowTerms, POINTS};
 use super::roles::Role;
 use super::source::GraphClip;
 use super::style::{
@@ -35,9 +37,7 @@ use super::{GraphError, HALF, WINDOW};
 
 /// Rows between exact recomputations of the diagonal running sums.
 pub const RESTART: usize = 32;
-/// Columns per register block of the dot-product kernel.
-const LANES: usize = 16;
-/// Coordinates per frame in the kernel's row layout: x (16) then z (16).
+/// Coordinates per frame in the kernel's xz layout: x (16) then z (16).
 const XZ: usize = 2 * Role::COUNT;
 
 /// Parameters of a graph build.
@@ -95,16 +95,18 @@ struct Candidate {
     d: f32,
 }
 
-/// Frame-level layout of the concatenated library.
+/// Frame-level layout of the concatenated library, structure of arrays (row-major, f32).
 struct Layout {
     /// Clip index of every global frame.
     clip_of: Vec<u32>,
     /// Window terms of every global frame that is a valid window centre.
     terms: Vec<Option<WindowTerms>>,
-    /// x then z of the 16 role points, per frame (kernel rows).
-    xz: Vec<[f32; XZ]>,
-    /// y of the 16 role points, per frame.
-    y: Vec<[f32; Role::COUNT]>,
+    /// Per frame: x of the 16 role points, then z (`N × 32`).
+    xz: Vec<f32>,
+    /// Per frame: z of the 16 role points, then −x (`N × 32`): `xz · zx` = Σ x z' − z x'.
+    zx: Vec<f32>,
+    /// Per frame: y of the 16 role points (`N × 16`).
+    y: Vec<f32>,
 }
 
 impl Layout {
@@ -113,8 +115,9 @@ impl Layout {
         let mut l = Layout {
             clip_of: Vec::with_capacity(n),
             terms: Vec::with_capacity(n),
-            xz: Vec::with_capacity(n),
-            y: Vec::with_capacity(n),
+            xz: Vec::with_capacity(n * XZ),
+            zx: Vec::with_capacity(n * XZ),
+            y: Vec::with_capacity(n * Role::COUNT),
         };
         for (ci, c) in clips.iter().enumerate() {
             let t = window_terms(&c.points);
@@ -122,15 +125,11 @@ impl Layout {
                 l.clip_of.push(ci as u32);
                 l.terms
                     .push(f.checked_sub(HALF).and_then(|w| t.get(w)).copied());
-                let mut xz = [0.0; XZ];
-                let mut y = [0.0; Role::COUNT];
-                for (k, v) in p.iter().enumerate() {
-                    xz[k] = v.x;
-                    xz[Role::COUNT + k] = v.z;
-                    y[k] = v.y;
-                }
-                l.xz.push(xz);
-                l.y.push(y);
+                l.xz.extend(p.iter().map(|v| v.x));
+                l.xz.extend(p.iter().map(|v| v.z));
+                l.zx.extend(p.iter().map(|v| v.z));
+                l.zx.extend(p.iter().map(|v| -v.x));
+                l.y.extend(p.iter().map(|v| v.y));
             }
         }
         l
@@ -142,62 +141,38 @@ impl Layout {
 }
 
 /// Frame-pair dot products for rows `r0..r0+nr` × columns `c0..c0+nc` (global frames):
-/// returns (Σ xx'+zz', Σ xz'−zx', Σ yy') each `nr × ncp` with `ncp` = nc rounded up to LANES.
+/// (Σ xx'+zz', Σ xz'−zx', Σ yy'), each `nr × nc` row-major. Three small matrix products
+/// (matrixmultiply's kernels, which pick AVX2/FMA at run time when the CPU has them).
 fn frame_products(l: &Layout, r0: usize, nr: usize, c0: usize, nc: usize) -> [Vec<f32>; 3] {
-    let blocks = nc.div_ceil(LANES);
-    let ncp = blocks * LANES;
-    // Column blocks, structure of arrays: for block q and coordinate k, 16 columns.
-    let mut ca = vec![[0.0f32; LANES]; blocks * XZ];
-    let mut cb = vec![[0.0f32; LANES]; blocks * XZ];
-    let mut cy = vec![[0.0f32; LANES]; blocks * Role::COUNT];
-    for c in 0..nc {
-        let (q, lane) = (c / LANES, c % LANES);
-        let xz = &l.xz[c0 + c];
-        for k in 0..Role::COUNT {
-            let (x, z) = (xz[k], xz[Role::COUNT + k]);
-            ca[q * XZ + k][lane] = x;
-            ca[q * XZ + Role::COUNT + k][lane] = z;
-            // Pairs with (x, z) of the row: x z' − z x'.
-            cb[q * XZ + k][lane] = z;
-            cb[q * XZ + Role::COUNT + k][lane] = -x;
-            cy[q * Role::COUNT + k][lane] = l.y[c0 + c][k];
+    fn view(v: &[f32], w: usize, at: usize, rows: usize) -> Option<ArrayView2<'_, f32>> {
+        ArrayView2::from_shape((rows, w), v.get(at * w..(at + rows) * w)?).ok()
+    }
+    let mut out = [
+        vec![0.0f32; nr * nc],
+        vec![0.0f32; nr * nc],
+        vec![0.0f32; nr * nc],
+    ];
+    let jobs = [
+        (&l.xz, &l.xz, XZ),
+        (&l.xz, &l.zx, XZ),
+        (&l.y, &l.y, Role::COUNT),
+    ];
+    for ((left, right, w), o) in jobs.into_iter().zip(out.iter_mut()) {
+        let (Some(a), Some(b)) = (view(left, w, r0, nr), view(right, w, c0, nc)) else {
+            continue;
+        };
+        if let Ok(mut c) = ArrayViewMut2::from_shape((nr, nc), o.as_mut_slice()) {
+            general_mat_mul(1.0, &a, &b.t(), 0.0, &mut c);
         }
     }
-    let mut pa = vec![0.0f32; nr * ncp];
-    let mut pb = vec![0.0f32; nr * ncp];
-    let mut py = vec![0.0f32; nr * ncp];
-    for r in 0..nr {
-        let row = &l.xz[r0 + r];
-        let ry = &l.y[r0 + r];
-        for q in 0..blocks {
-            let mut aa = [0.0f32; LANES];
-            let mut ab = [0.0f32; LANES];
-            let mut ay = [0.0f32; LANES];
-            for (k, &s) in row.iter().enumerate() {
-                let va = &ca[q * XZ + k];
-                let vb = &cb[q * XZ + k];
-                for t in 0..LANES {
-                    aa[t] += s * va[t];
-                    ab[t] += s * vb[t];
-                }
-            }
-            for (k, &s) in ry.iter().enumerate() {
-                let vy = &cy[q * Role::COUNT + k];
-                for t in 0..LANES {
-                    ay[t] += s * vy[t];
-                }
-            }
-            let o = r * ncp + q * LANES;
-            pa[o..o + LANES].copy_from_slice(&aa);
-            pb[o..o + LANES].copy_from_slice(&ab);
-            py[o..o + LANES].copy_from_slice(&ay);
-        }
-    }
-    [pa, pb, py]
+    out
 }
 
-/// Evaluates one tile of window centres `i0..i1` × `j0..j1` and returns its local minima and
-/// the (min, max) distance over its valid pairs.
+/// Evaluates one tile of window centres `i0..i1` × `j0..j1` and returns its local minima, the
+/// (min, max) distance over its valid pairs above the diagonal, and their number.
+///
+/// Every inner loop runs over a contiguous row with no data-dependent branch, so it vectorises;
+/// invalid column centres carry an infinite `sq` term, which makes their distance infinite.
 fn tile(
     l: &Layout,
     p: &BuildParams,
@@ -217,10 +192,19 @@ fn tile(
     let (nr, nc) = (ri1 - ri0, cj1 - cj0);
     let (fr, fc) = (nr + WINDOW - 1, nc + WINDOW - 1);
     let [pa, pb, py] = frame_products(l, ri0 - HALF, fr, cj0 - HALF, fc);
-    let stride = fc.div_ceil(LANES) * LANES;
-    let diag = |m: &[f32], r: usize, c: usize| -> f32 {
-        (0..WINDOW).map(|k| m[(r + k) * stride + c + k]).sum()
-    };
+    let stride = fc;
+    // Column terms, structure of arrays.
+    let w = POINTS as f32;
+    let mut cmx = vec![0.0f32; nc];
+    let mut cmz = vec![0.0f32; nc];
+    let mut csq = vec![f32::INFINITY; nc];
+    for c in 0..nc {
+        if let Some(t) = l.terms[cj0 + c] {
+            cmx[c] = t.mx;
+            cmz[c] = t.mz;
+            csq[c] = t.sq;
+        }
+    }
     let mut sums = [vec![0.0f32; nc], vec![0.0f32; nc], vec![0.0f32; nc]];
     let mut next = sums.clone();
     let mut d = vec![f32::INFINITY; nr * nc];
@@ -229,82 +213,161 @@ fn tile(
     for r in 0..nr {
         for (m, (s, nx)) in [&pa, &pb, &py].iter().zip(sums.iter().zip(next.iter_mut())) {
             if r % RESTART == 0 {
-                for (c, v) in nx.iter_mut().enumerate() {
-                    *v = diag(m, r, c);
+                nx.iter_mut().for_each(|v| *v = 0.0);
+                for k in 0..WINDOW {
+                    let src = &m[(r + k) * stride + k..(r + k) * stride + k + nc];
+                    nx.iter_mut().zip(src).for_each(|(v, x)| *v += x);
                 }
             } else {
-                nx[0] = diag(m, r, 0);
-                let add = &m[(r + WINDOW - 1) * stride + WINDOW..];
-                let sub = &m[(r - 1) * stride..];
-                for c in 1..nc {
-                    nx[c] = s[c - 1] + add[c - 1] - sub[c - 1];
+                nx[0] = (0..WINDOW).map(|k| m[(r + k) * stride + k]).sum();
+                let add = &m[(r + WINDOW - 1) * stride + WINDOW..][..nc - 1];
+                let sub = &m[(r - 1) * stride..][..nc - 1];
+                for (((v, s), a), b) in nx[1..].iter_mut().zip(&s[..nc - 1]).zip(add).zip(sub) {
+                    *v = s + a - b;
                 }
             }
         }
         std::mem::swap(&mut sums, &mut next);
         let gi = ri0 + r;
         let Some(ti) = l.terms[gi] else { continue };
-        let ci = l.clip_of[gi];
         let row = &mut d[r * nc..(r + 1) * nc];
-        for (c, out) in row.iter_mut().enumerate() {
-            let gj = cj0 + c;
-            let Some(tj) = l.terms[gj] else { continue };
-            if l.clip_of[gj] == ci && gi.abs_diff(gj) < p.min_gap {
-                continue;
+        let cols = cmx.iter().zip(&cmz).zip(&csq);
+        let s = sums[0].iter().zip(&sums[1]).zip(&sums[2]);
+        for (out, (((sa, sb), syy), ((mx, mz), sq))) in row.iter_mut().zip(s.zip(cols)) {
+            let a = sa - w * (ti.mx * mx + ti.mz * mz);
+            let b = sb - w * (ti.mx * mz - ti.mz * mx);
+            let v = (ti.sq + sq - 2.0 * (syy + (a * a + b * b).sqrt())) / w;
+            *out = v.max(0.0);
+        }
+        // Windows of the same clip closer than the gap are no transitions.
+        let ci = l.clip_of[gi];
+        let near = gi.saturating_sub(p.min_gap - 1).max(cj0)..(gi + p.min_gap).min(cj1);
+        for gj in near {
+            if l.clip_of[gj] == ci {
+                row[gj - cj0] = f32::INFINITY;
             }
-            let (v, _, _) = closed_form(&ti, &tj, sums[0][c], sums[1][c], sums[2][c]);
-            *out = v;
-            if (i0..i1).contains(&gi) && (j0..j1).contains(&gj) && gi < gj {
-                dmin = dmin.min(v);
-                dmax = dmax.max(v);
-                pairs += 1;
+        }
+        if (i0..i1).contains(&gi) {
+            let c_lo = j0.max(gi + 1).max(cj0) - cj0;
+            let c_hi = j1.min(cj1).saturating_sub(cj0);
+            if c_lo < c_hi {
+                let (lo, hi, cnt) = row_stats(&row[c_lo..c_hi]);
+                dmin = fmin(dmin, lo);
+                dmax = fmax(dmax, hi);
+                pairs += cnt;
+            }
+        }
+    }
+    // 3 × 3 minimum filter, separable: along rows, then across rows.
+    let mut hmin = vec![f32::INFINITY; nr * nc];
+    for r in 0..nr {
+        let row = &d[r * nc..(r + 1) * nc];
+        let out = &mut hmin[r * nc..(r + 1) * nc];
+        out[0] = fmin(row[0], row.get(1).copied().unwrap_or(f32::INFINITY));
+        if nc >= 2 {
+            out[nc - 1] = fmin(row[nc - 1], row[nc - 2]);
+        }
+        if nc >= 3 {
+            let three = row[..nc - 2].iter().zip(&row[1..nc - 1]).zip(&row[2..]);
+            for (o, ((a, b), c)) in out[1..nc - 1].iter_mut().zip(three) {
+                *o = fmin(fmin(*a, *b), *c);
             }
         }
     }
     let mut out = Vec::new();
+    let get = |r: usize, c: usize| d[r * nc + c];
     for r in 0..nr {
         let gi = ri0 + r;
         if !(i0..i1).contains(&gi) {
             continue;
         }
-        for c in 0..nc {
-            let gj = cj0 + c;
-            if !(j0..j1).contains(&gj) || gi >= gj {
-                continue;
-            }
-            let v = d[r * nc + c];
-            if !v.is_finite() {
-                continue;
-            }
-            let mut is_min = true;
-            'n: for dr in -1i64..=1 {
-                for dc in -1i64..=1 {
-                    if dr == 0 && dc == 0 {
-                        continue;
-                    }
-                    let (rr, cc) = (r as i64 + dr, c as i64 + dc);
-                    if rr < 0 || cc < 0 || rr >= nr as i64 || cc >= nc as i64 {
-                        continue;
-                    }
-                    let w = d[rr as usize * nc + cc as usize];
-                    // Ties: the earlier cell in raster order wins.
-                    let before = dr < 0 || (dr == 0 && dc < 0);
-                    if w < v || (before && w == v) {
-                        is_min = false;
-                        break 'n;
-                    }
+        let up = if r > 0 {
+            &hmin[(r - 1) * nc..r * nc]
+        } else {
+            &hmin[r * nc..(r + 1) * nc]
+        };
+        let down = if r + 1 < nr {
+            &hmin[(r + 1) * nc..(r + 2) * nc]
+        } else {
+            &hmin[r * nc..(r + 1) * nc]
+        };
+        let mid = &hmin[r * nc..(r + 1) * nc];
+        let row = &d[r * nc..(r + 1) * nc];
+        let mut around = vec![0.0f32; nc];
+        for (m, ((a, b), c)) in around.iter_mut().zip(up.iter().zip(mid).zip(down)) {
+            *m = fmin(fmin(*a, *b), *c);
+        }
+        for (c, (&v, &m)) in row.iter().zip(&around).enumerate() {
+            if v <= m && v < f32::INFINITY {
+                // Rare: v is a (possibly tied) minimum. Ties go to the earlier cell in raster order.
+                let gj = cj0 + c;
+                if !(j0..j1).contains(&gj) || gi >= gj {
+                    continue;
                 }
-            }
-            if is_min {
-                out.push(Candidate {
-                    i: gi as u32,
-                    j: gj as u32,
-                    d: v,
-                });
+                let tied_before = (c > 0 && get(r, c - 1) == v)
+                    || (r > 0
+                        && (c.saturating_sub(1)..(c + 2).min(nc)).any(|cc| get(r - 1, cc) == v));
+                if !tied_before {
+                    out.push(Candidate {
+                        i: gi as u32,
+                        j: gj as u32,
+                        d: v,
+                    });
+                }
             }
         }
     }
     (out, dmin, dmax, pairs)
+}
+
+/// Minimum without NaN handling (the distances are never NaN), so loops vectorise.
+#[inline(always)]
+fn fmin(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// Maximum without NaN handling.
+#[inline(always)]
+fn fmax(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// (min, max over finite values, number of finite values) of a row, in 8 independent lanes.
+fn row_stats(row: &[f32]) -> (f32, f32, u64) {
+    const L: usize = 8;
+    let mut lo = [f32::INFINITY; L];
+    let mut hi = [f32::NEG_INFINITY; L];
+    let mut cnt = [0u32; L];
+    let chunks = row.chunks_exact(L);
+    let rest = chunks.remainder();
+    for ch in chunks {
+        for k in 0..L {
+            let v = ch[k];
+            let finite = v < f32::INFINITY;
+            lo[k] = fmin(lo[k], v);
+            hi[k] = fmax(hi[k], if finite { v } else { f32::NEG_INFINITY });
+            cnt[k] += u32::from(finite);
+        }
+    }
+    let mut out = (
+        lo.iter().copied().fold(f32::INFINITY, fmin),
+        hi.iter().copied().fold(f32::NEG_INFINITY, fmax),
+        cnt.iter().map(|&c| c as u64).sum::<u64>(),
+    );
+    for &v in rest {
+        if v < f32::INFINITY {
+            out = (fmin(out.0, v), fmax(out.1, v), out.2 + 1);
+        }
+    }
+    out
 }
 
 /// Builds the motion graph of `clips` (all at 30 fps, each at least one window long).
@@ -559,7 +622,12 @@ pub(crate) mod tests {
                 let v = get(e.from, e.to).unwrap();
                 for (di, dj) in [(-1i64, 0i64), (1, 0), (0, 1), (0, -1), (1, 1), (-1, -1)] {
                     if let Some(w) = get((e.from as i64 + di) as u32, (e.to as i64 + dj) as u32) {
-                        assert!(w >= v - 1e-3, "({},{}) {v} has neighbour {w}", e.from, e.to);
+                        assert!(
+                            w >= v - 1e-3,
+                            "tile {tile_size} ({},{}) {v} has neighbour {w} at {di},{dj}",
+                            e.from,
+                            e.to
+                        );
                     }
                 }
             }
