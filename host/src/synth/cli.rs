@@ -1,0 +1,426 @@
+//! `figurine synth …`: the command-line face of the doodle generator.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+
+use super::effort::Effort;
+use super::gesture::Action;
+use super::knobs::{Knobs, Range};
+use super::sampling::SignMode;
+use super::sequence::{effort_set, examples, gesture, sequence, Doodle};
+
+/// Most actions in one `sequence` log (≈ 2–3 s each; 10 000 actions at 240 Hz ≈ 6 M samples,
+/// ≈ 400 MB in memory).
+pub const MAX_SEQUENCE_ACTIONS: usize = 10_000;
+/// Most logs per effort state in `effort-set`, and most `examples`.
+pub const MAX_SET_SIZE: usize = 100_000;
+
+/// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+#[derive(Args, Debug)]
+pub struct SynthArgs {
+    #[command(subcommand)]
+    command: Box<SynthCommand>,
+}
+
+#[derive(Subcommand, Debug)]
+enum SynthCommand {
+    /// One performance of one action.
+    Gesture {
+        /// Action name (walk, run, jump, punch, throw, kick, turn, sidestep, crouch, bow, wave,
+        /// spin).
+        #[arg(long)]
+        action: Action,
+        /// Effort: sudden-strong, sudden-light, sustained-strong, sustained-light, neutral, or
+        /// random (one of the four states).
+        #[arg(long, default_value = "random")]
+        effort: EffortArg,
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output pose log (CSV).
+        #[arg(long)]
+        out: PathBuf,
+        /// Also write the label as a one-element JSON array here.
+        #[arg(long)]
+        labels: Option<PathBuf>,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// A labelled sequence of random actions separated by still pauses.
+    Sequence {
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Number of actions.
+        #[arg(long, default_value_t = 8)]
+        count: usize,
+        /// Effort of every action (default: a random state per action).
+        #[arg(long, default_value = "random")]
+        effort: EffortArg,
+        /// Output pose log (CSV).
+        #[arg(long)]
+        out: PathBuf,
+        /// Output labels (JSON array of {action, start, end, time_class, weight_class}).
+        #[arg(long)]
+        labels: PathBuf,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// One-gesture logs in sudden-strong/, sudden-light/, sustained-strong/, sustained-light/.
+    EffortSet {
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Logs per effort state.
+        #[arg(long, default_value_t = 24)]
+        per_class: usize,
+        /// Output folder (created; also gets labels.json listing every file).
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// Learning examples of one action: NAME_1.csv … NAME_K.csv.
+    Examples {
+        /// Action name.
+        #[arg(long)]
+        action: Action,
+        /// Number of examples.
+        #[arg(long, default_value_t = 3)]
+        count: usize,
+        /// Effort of the examples (default: a random state each).
+        #[arg(long, default_value = "random")]
+        effort: EffortArg,
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output folder (created).
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// A picture of every action, or of one action in the four effort states.
+    ///
+    /// Without `--action`: one performance of every action (walk, run, jump, punch, throw,
+    /// kick, turn, sidestep, crouch, bow, wave, spin) plotted small on a 4×3 grid. With
+    /// `--action`: that action in the four effort states (same seed, so only the effort
+    /// differs), 2×2.
+    Gallery {
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Compare the four effort states of this action instead.
+        #[arg(long)]
+        action: Option<Action>,
+        /// Effort of every performance (default: a random state each).
+        #[arg(long, default_value = "random")]
+        effort: EffortArg,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// Draw a pose log as a PNG: top view, side view, speeds over time, label spans.
+    Plot {
+        /// The pose log (CSV).
+        log: PathBuf,
+        /// Labels JSON to shade (optional).
+        #[arg(long)]
+        labels: Option<PathBuf>,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// `random` or a named effort.
+#[derive(Debug, Clone, Copy)]
+struct EffortArg(Option<Effort>);
+
+impl std::str::FromStr for EffortArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("random") {
+            Ok(Self(None))
+        } else {
+            s.parse().map(|e| Self(Some(e)))
+        }
+    }
+}
+
+/// Nuisance-parameter ranges; each takes `V` or `LO..HI`. Defaults are wide.
+#[derive(Args, Debug, Clone)]
+struct KnobArgs {
+    /// Nominal sample rate, Hz [default: 30..240; up to 2000].
+    #[arg(long, allow_hyphen_values = true)]
+    rate: Option<Range>,
+    /// Timestamp jitter, fraction of a period [default: 0..0.25; at most 0.45].
+    #[arg(long, allow_hyphen_values = true)]
+    jitter: Option<Range>,
+    /// Probability of a dropped sample [default: 0..0.01].
+    #[arg(long, allow_hyphen_values = true)]
+    drop: Option<Range>,
+    /// Spatial scale of the doodle [default: 0.5..2].
+    #[arg(long, allow_hyphen_values = true)]
+    scale: Option<Range>,
+    /// Tempo multiplier (durations divided by it) [default: 0.8..1.25].
+    #[arg(long, allow_hyphen_values = true)]
+    speed: Option<Range>,
+    /// Heading of the doodle, degrees about +Y [default: -180..180].
+    #[arg(long, allow_hyphen_values = true)]
+    heading: Option<Range>,
+    /// Tilt of the toy in the hand, degrees [default: 0..10].
+    #[arg(long, allow_hyphen_values = true)]
+    tilt: Option<Range>,
+    /// Start x and z in the room, metres [default: -2..2].
+    #[arg(long, allow_hyphen_values = true)]
+    room: Option<Range>,
+    /// Start height, metres [default: 0.4..1.5].
+    #[arg(long, allow_hyphen_values = true)]
+    height: Option<Range>,
+    /// Multiplier of sensor noise, tremor and drift; 0 = clean [default: 0.5..1.5].
+    #[arg(long, allow_hyphen_values = true)]
+    noise: Option<Range>,
+    /// Log clock at the first sample, seconds [default: 0..10].
+    #[arg(long, allow_hyphen_values = true)]
+    t0: Option<Range>,
+    /// Still time before the first action, seconds [default: 0.4..1.2].
+    #[arg(long, allow_hyphen_values = true)]
+    lead: Option<Range>,
+    /// Still time between actions and after the last, seconds [default: 0.3..1.5].
+    #[arg(long, allow_hyphen_values = true)]
+    pause: Option<Range>,
+    /// Quaternion sign convention: continuous, canonical, flips [default: random per doodle].
+    #[arg(long)]
+    quat_sign: Option<SignMode>,
+    /// Probability per sample of a tracker glitch: spike, NaN row, zero quaternion, repeated or
+    /// backward timestamp [default: 0].
+    #[arg(long)]
+    glitch: Option<Range>,
+    /// A perfect tracker: no noise, tremor, drift, jitter, drops or glitches (overrides those).
+    #[arg(long)]
+    clean: bool,
+}
+
+impl KnobArgs {
+    fn knobs(&self) -> Result<Knobs> {
+        let d = Knobs::default();
+        let mut k = Knobs {
+            rate_hz: self.rate.unwrap_or(d.rate_hz),
+            jitter: self.jitter.unwrap_or(d.jitter),
+            drop: self.drop.unwrap_or(d.drop),
+            scale: self.scale.unwrap_or(d.scale),
+            speed: self.speed.unwrap_or(d.speed),
+            heading_deg: self.heading.unwrap_or(d.heading_deg),
+            tilt_deg: self.tilt.unwrap_or(d.tilt_deg),
+            room_m: self.room.unwrap_or(d.room_m),
+            height_m: self.height.unwrap_or(d.height_m),
+            noise: self.noise.unwrap_or(d.noise),
+            t0: self.t0.unwrap_or(d.t0),
+            lead_s: self.lead.unwrap_or(d.lead_s),
+            pause_s: self.pause.unwrap_or(d.pause_s),
+            sign: self.quat_sign,
+            glitch: self.glitch.unwrap_or(d.glitch),
+        };
+        if self.clean {
+            k.noise = Range::fixed(0.0);
+            k.jitter = Range::fixed(0.0);
+            k.drop = Range::fixed(0.0);
+            k.glitch = Range::fixed(0.0);
+        }
+        k.validate().map_err(anyhow::Error::msg)?;
+        Ok(k)
+    }
+}
+
+fn write_doodle(d: &Doodle, out: &Path) -> Result<()> {
+    if let Some(dir) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    d.write_csv(out)
+        .with_context(|| format!("writing {}", out.display()))
+}
+
+/// Labels listed in full by the summary; longer sequences are elided.
+const SUMMARY_LABELS: usize = 24;
+
+/// Prints what was written. Write errors (e.g. a closed pipe) are ignored: the files are done.
+fn summary(d: &Doodle, out: &Path) {
+    use std::io::Write;
+    let mut w = std::io::stdout().lock();
+    let n = d.log.samples.len();
+    let (t0, t1) = match (d.log.samples.first(), d.log.samples.last()) {
+        (Some(a), Some(b)) => (a.t, b.t),
+        _ => (0.0, 0.0),
+    };
+    let _ = writeln!(
+        w,
+        "{}: {n} samples, {t0:.3}..{t1:.3} s, {}",
+        out.display(),
+        d.variation
+    );
+    for l in d.labels.iter().take(SUMMARY_LABELS) {
+        let _ = writeln!(
+            w,
+            "  {:<9} {:>9.3} .. {:>9.3} s  {:?}/{:?}",
+            l.action, l.start, l.end, l.time_class, l.weight_class
+        );
+    }
+    if d.labels.len() > SUMMARY_LABELS {
+        let _ = writeln!(w, "  … {} more", d.labels.len() - SUMMARY_LABELS);
+    }
+}
+
+/// Prints one line, ignoring a closed pipe.
+fn say(line: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout().lock(), "{line}");
+}
+
+/// Runs `figurine synth …`.
+pub fn run(args: SynthArgs) -> Result<()> {
+    match *args.command {
+        SynthCommand::Gesture {
+            action,
+            effort,
+            seed,
+            out,
+            labels,
+            knobs,
+        } => {
+            let knobs = knobs.knobs()?;
+            let effort = effort
+                .0
+                .unwrap_or_else(|| super::sequence::random_state_for(seed));
+            let d = gesture(seed, &knobs, action, effort);
+            write_doodle(&d, &out)?;
+            if let Some(l) = labels {
+                d.write_labels(&l)
+                    .with_context(|| format!("writing {}", l.display()))?;
+            }
+            summary(&d, &out);
+        }
+        SynthCommand::Sequence {
+            seed,
+            count,
+            effort,
+            out,
+            labels,
+            knobs,
+        } => {
+            if count == 0 || count > MAX_SEQUENCE_ACTIONS {
+                bail!("--count {count}: must be within 1..={MAX_SEQUENCE_ACTIONS}");
+            }
+            let knobs = knobs.knobs()?;
+            let d = sequence(seed, &knobs, count, effort.0);
+            write_doodle(&d, &out)?;
+            d.write_labels(&labels)
+                .with_context(|| format!("writing {}", labels.display()))?;
+            summary(&d, &out);
+        }
+        SynthCommand::EffortSet {
+            seed,
+            per_class,
+            out,
+            knobs,
+        } => {
+            if per_class == 0 || per_class > MAX_SET_SIZE {
+                bail!("--per-class {per_class}: must be within 1..={MAX_SET_SIZE}");
+            }
+            let knobs = knobs.knobs()?;
+            let set = effort_set(seed, &knobs, per_class);
+            let mut index = Vec::with_capacity(set.len());
+            let mut counter = std::collections::BTreeMap::<String, usize>::new();
+            for (state, d) in &set {
+                let dir = out.join(state.name());
+                let k = counter.entry(state.name()).or_default();
+                let action = d.labels.first().map_or("none", |l| l.action.as_str());
+                let file = dir.join(format!("{:04}_{action}.csv", *k));
+                *k += 1;
+                write_doodle(d, &file)?;
+                index.push(serde_json::json!({
+                    "file": file.strip_prefix(&out).unwrap_or(&file).to_string_lossy(),
+                    "seed": d.seed,
+                    "labels": d.labels,
+                }));
+            }
+            let idx = out.join("labels.json");
+            std::fs::write(&idx, serde_json::to_string_pretty(&index)? + "\n")
+                .with_context(|| format!("writing {}", idx.display()))?;
+            say(format_args!(
+                "{}: {} logs in {} effort folders (index: {})",
+                out.display(),
+                set.len(),
+                Effort::STATES.len(),
+                idx.display()
+            ));
+        }
+        SynthCommand::Examples {
+            action,
+            count,
+            effort,
+            seed,
+            out,
+            knobs,
+        } => {
+            if count == 0 || count > MAX_SET_SIZE {
+                bail!("--count {count}: must be within 1..={MAX_SET_SIZE}");
+            }
+            let knobs = knobs.knobs()?;
+            for (i, d) in examples(seed, &knobs, action, count, effort.0)
+                .iter()
+                .enumerate()
+            {
+                let file = out.join(format!("{}_{}.csv", action.name(), i + 1));
+                write_doodle(d, &file)?;
+                summary(d, &file);
+            }
+        }
+        SynthCommand::Gallery {
+            seed,
+            action,
+            effort,
+            out,
+            knobs,
+        } => {
+            let knobs = knobs.knobs()?;
+            let tile = |s: u64, a: Action, e: Effort| {
+                let d = gesture(s, &knobs, a, e);
+                (super::plot::plot(&d.log, &d.labels), format!("{a} {e}"))
+            };
+            let (pics, cols): (Vec<_>, u32) = match action {
+                Some(a) => (
+                    Effort::STATES.iter().map(|&e| tile(seed, a, e)).collect(),
+                    2,
+                ),
+                None => (
+                    Action::ALL
+                        .iter()
+                        .enumerate()
+                        .map(|(i, &a)| {
+                            let s = super::sequence::item_seed(seed, i as u64);
+                            let e = effort
+                                .0
+                                .unwrap_or_else(|| super::sequence::random_state_for(s));
+                            tile(s, a, e)
+                        })
+                        .collect(),
+                    4,
+                ),
+            };
+            super::plot::gallery(&pics, cols)
+                .save(&out)
+                .with_context(|| format!("writing {}", out.display()))?;
+            say(format_args!("{}", out.display()));
+        }
+        SynthCommand::Plot { log, labels, out } => {
+            super::plot::plot_files(&log, labels.as_deref(), &out)?;
+            say(format_args!("{}", out.display()));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,49 @@
+//! `figurine synth`: the project's own seeded generator of synthetic spatial motion doodles.
+//!
+//! A doodle is the 6-DoF trajectory of a toy figurine played by a child or an animator
+//! (DESIGN.md conventions: world metres, +Y up; object frame +Z front, +Y up, +X left;
+//! quaternion w,x,y,z object→world; time in seconds). The generator plays the twelve actions of
+//! [`gesture::Action`] with natural variation between performances, shapes them with the four
+//! Laban effort states of [`effort::Effort`] (seed 000 §5), and lays a tracker model over them:
+//! sensor noise, hand tremor, drift, jittered sample clocks at 30–240 Hz (up to 2 kHz on
+//! request), both quaternion signs. Every nuisance parameter — scale, tempo, heading, tilt,
+//! start position — is drawn from wide [`knobs::Knobs`] ranges. Output is deterministic per
+//! seed and written with [`crate::poselog`].
+//!
+//! Data flow, one file per stage: [`rng`] (seeded streams) → [`knobs`] (nuisance draw) →
+//! [`effort`] + [`mod@gesture`] (strokes) → [`trajectory`] (clean pose over time) → [`sampling`]
+//! (sample instants, quaternion sign) + [`noise`] (sensor, hand, optional glitches) →
+//! [`mod@sequence`] (labelled doodles and sets) → [`cli`] / [`plot`] (+ [`font`] for captions).
+//!
+//! How the effort classes show in the data (what a recognizer can learn): Time in stroke
+//! durations (sustained ≈ 3× sudden) and peak speeds (≥ 1.9× at equal weight); Weight in
+//! amplitude (strong ≈ 1.7× light) and in how strokes end — strong strokes stop in a ~20 ms
+//! impact with a small bounce, light ones fade out — so peak deceleration over peak
+//! acceleration separates them without knowing the doodle's scale. Impacts need ≳ 60 Hz to be
+//! seen; at 30 Hz Weight shows mostly through amplitude and speed.
+//!
+//! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot` (see
+//! [`cli`]). Library use (in-process, no files):
+//! ```
+//! use figurine_host::synth::{gesture, Action, Effort, Knobs};
+//! let d = gesture(7, &Knobs::default(), Action::Jump, "sudden-strong".parse().unwrap());
+//! assert!(d.log.samples.len() > 30);
+//! assert_eq!(d.labels[0].action, "jump");
+//! ```
+
+pub mod cli;
+pub mod effort;
+pub mod font;
+pub mod gesture;
+pub mod knobs;
+pub mod noise;
+pub mod plot;
+pub mod rng;
+pub mod sampling;
+pub mod sequence;
+pub mod trajectory;
+
+pub use effort::{Effort, TimeClass, WeightClass};
+pub use gesture::Action;
+pub use knobs::{Knobs, Range, Variation};
+pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label, Performer};
