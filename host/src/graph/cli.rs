@@ -283,6 +283,26 @@ fn synth(a: SynthArgs) -> anyhow::Result<()> {
         used.join(" → "),
         a.out.display()
     );
+    let cuts: Vec<String> = p
+        .cuts
+        .iter()
+        .map(|(k, t)| {
+            let name = |f: u32| {
+                g.clip_of(f)
+                    .map(|c| g.clips[c].name.as_str())
+                    .unwrap_or("?")
+            };
+            format!(
+                "{:.2}s {}→{} (posture {:.2}, style {:.2})",
+                *k as f32 / FPS,
+                name(t.from),
+                name(t.to),
+                t.posture,
+                t.style
+            )
+        })
+        .collect();
+    println!("transitions at: {}", cuts.join("; "));
     if let Some(glb) = &a.glb {
         let scale = p
             .frames

@@ -1,12 +1,13 @@
 //! Synthesis on a motion graph: by highest similarity (§5.3) and by example (§5.4).
 //!
 //! Planning walks the largest strongly connected component of the chosen variant (so the walk
-//! never dead-ends): it plays a clip forward and, every 80–100 frames (drawn per segment from a
-//! seeded generator), takes the transition with the highest similarity found within that
-//! window of frames — posture correlation for MG, style correlation for LMA-MG (the paper's
+//! never dead-ends): it starts at a seeded random frame, plays the clip forward and, between 80
+//! and 100 frames after the previous jump, takes the transition with the highest similarity
+//! found in that span — posture correlation for MG, style correlation for LMA-MG (the paper's
 //! choice), or, by example, the destination window whose style best matches the reference clip's
 //! window at that output time. When the clip would leave the component, the best available
-//! transition is taken at once.
+//! transition is taken at once. Landing again near one of the last [`RECENT_JUMPS`] landings
+//! costs [`REPEAT_PENALTY`], so a walk does not loop one passage when it has other choices.
 //!
 //! Rendering turns the plan into poses of the source clips: every segment is placed with a
 //! rotation about the vertical and a floor translation (eq. 1's alignment of the two windows,
@@ -26,12 +27,17 @@ use super::posture::align_windows;
 use super::roles::RoleOverrides;
 use super::source::{load_clip, GraphClip};
 use super::style::{pearson, similarity};
-use super::{GraphError, HALF};
+use super::{GraphError, HALF, WINDOW};
 
 /// Fewest frames between forced transitions (§5.3).
 pub const MIN_SEGMENT: usize = 80;
 /// Most frames between forced transitions (§5.3).
 pub const MAX_SEGMENT: usize = 100;
+
+/// Jumps remembered to avoid looping the same passage.
+pub const RECENT_JUMPS: usize = 8;
+/// Score subtracted from a transition landing within a window of a recent jump's landing.
+pub const REPEAT_PENALTY: f32 = 1.0;
 
 /// A small seeded generator (SplitMix64) so plans are reproducible.
 #[derive(Debug, Clone)]
@@ -125,12 +131,19 @@ pub fn plan(
             _ => 0.0,
         }
     };
+    // Destinations of the last few jumps: landing there again would loop the same passage.
+    let recent = std::cell::RefCell::new(std::collections::VecDeque::<u32>::new());
     let score = |t: &Transition, out_frame: usize| -> f32 {
-        match chooser {
+        let base = match chooser {
             Chooser::Similarity(Variant::Mg) => t.posture,
             Chooser::Similarity(Variant::Lma) => t.style,
             Chooser::Example(_) => example_score(t.to, out_frame),
-        }
+        };
+        let repeat = recent
+            .borrow()
+            .iter()
+            .any(|&r| r.abs_diff(t.to) < WINDOW as u32);
+        base - if repeat { REPEAT_PENALTY } else { 0.0 }
     };
     let usable = |f: u32| -> Vec<Transition> {
         trans
@@ -174,14 +187,22 @@ pub fn plan(
     let mut since = 0usize;
     while out.frames.len() < frames {
         let natural = next_natural(cur);
+        // Frames playable before the clip leaves the component (bounded by the span's end).
+        let mut to_forced = 0usize;
+        let mut f = cur;
+        while to_forced < MAX_SEGMENT {
+            match next_natural(f) {
+                Some(n) => {
+                    f = n;
+                    to_forced += 1;
+                }
+                None => break,
+            }
+        }
         let mut take: Option<Transition> = None;
-        if natural.is_none() {
-            take = usable(cur)
-                .into_iter()
-                .max_by(|a, b| score(a, out.frames.len()).total_cmp(&score(b, out.frames.len())));
-        } else if since >= MIN_SEGMENT {
-            // Look ahead along the clip up to the end of the 80–100 window for the best jump.
-            let horizon = MAX_SEGMENT.saturating_sub(since).max(1);
+        // Decide in the 80–100 span, or earlier if the clip would force a jump before it.
+        if since >= MIN_SEGMENT || since + to_forced < MIN_SEGMENT || natural.is_none() {
+            let horizon = MAX_SEGMENT.saturating_sub(since).min(to_forced + 1).max(1);
             let mut best: Option<(f32, usize, Transition)> = None;
             let mut f = cur;
             for ahead in 0..horizon {
@@ -204,6 +225,11 @@ pub fn plan(
             Some(t) => {
                 cur = t.to + 1;
                 out.cuts.push((out.frames.len(), t));
+                let mut r = recent.borrow_mut();
+                r.push_back(t.to);
+                if r.len() > RECENT_JUMPS {
+                    r.pop_front();
+                }
                 since = 0;
             }
             None => match natural {
