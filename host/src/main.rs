@@ -23,6 +23,8 @@ enum Command {
     Animate(figurine_host::anim::cli::AnimateArgs),
     /// Inspect motion clips (`clip stages CLIP`).
     Clip(figurine_host::anim::cli::ClipArgs),
+    /// Style-coherent motion graphs: build, synth, eval (seed 003).
+    Graph(figurine_host::graph::cli::GraphArgs),
     /// Learn (or replace) an action's pattern from example pose logs.
     Learn(figurine_host::recognize::learn::LearnArgs),
     /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
@@ -57,6 +59,7 @@ fn main() -> anyhow::Result<()> {
         Command::ProtocolVersion => {
             println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
         }
+        Command::Graph(args) => figurine_host::graph::cli::run(args)?,
         Command::Learn(a) => figurine_host::recognize::learn::run(&a)?,
         Command::TrainEffort(a) => figurine_host::recognize::effort_train::run(&a)?,
         Command::Simulate(a) => figurine_host::recognize::simulate::run(&a)?,
