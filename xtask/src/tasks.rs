@@ -39,6 +39,7 @@ impl Board {
 const NO_STD_CRATES: &[(&str, &str)] = &[
     ("figurine-protocol", "defmt"),
     ("figurine-recognizer", "defmt"),
+    ("figurine-store", "defmt"),
 ];
 
 /// Builds the firmware for one board.
