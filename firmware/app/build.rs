@@ -7,7 +7,8 @@ use std::{env, fs, path::PathBuf};
 fn main() {
     let qemu = env::var_os("CARGO_FEATURE_QEMU").is_some();
     let nrf = env::var_os("CARGO_FEATURE_NRF52840").is_some();
-    let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let manifest =
+        PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let root = manifest.join("../..");
     let memory = match (qemu, nrf) {
         (true, false) => root.join("hw/mps2-an386/memory.x"),
@@ -19,7 +20,11 @@ fn main() {
     if qemu {
         // cortex-m-rt's `device` feature includes device.x; this board's vector table is
         // complete in Rust (board/qemu/vectors.rs), so it needs no extra symbols.
-        fs::write(out.join("device.x"), "/* mps2-an386: interrupts defined in Rust */\n").expect("write device.x");
+        fs::write(
+            out.join("device.x"),
+            "/* mps2-an386: interrupts defined in Rust */\n",
+        )
+        .expect("write device.x");
     }
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={}", memory.display());

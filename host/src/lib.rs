@@ -5,6 +5,7 @@
 pub mod anim;
 pub mod data;
 pub mod events;
+pub mod graph;
 pub mod link;
 pub mod motion;
 pub mod poselog;

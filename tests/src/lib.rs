@@ -2,6 +2,8 @@
 //! instance running it (reaped by a Drop guard, also when a test fails), and a connected
 //! host-side [`figurine_host::link::Device`].
 
+pub mod defmt_log;
+pub mod elf;
 pub mod pose6d;
 pub mod qemu;
 

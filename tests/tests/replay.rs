@@ -9,6 +9,7 @@ use figurine_host::link::blobs::{self, Blobs};
 use figurine_host::link::cli::upload_to;
 use figurine_host::link::{replay_log, Device, ReplayOptions};
 use figurine_host::poselog::PoseLog;
+use figurine_host::recognize::eval::learn_synth_library;
 use figurine_host::recognize::simulate::simulate_log;
 use figurine_host::synth::knobs::Knobs;
 use figurine_host::synth::sequence::sequence;
@@ -51,7 +52,21 @@ fn check_identical(dev: &mut Device, blobs: &Blobs, log: &PoseLog, what: &str) -
 
 #[test]
 fn device_events_match_simulation_on_synthetic_and_real_logs() {
-    let blobs = blobs::load(None, None).expect("default library and effort model");
+    // A library learnt from synthetic examples (3 per action, as a user would), the default
+    // effort model: the blobs a user's `figurine learn` + `upload` would put on the device.
+    let t = Instant::now();
+    let mut lib = learn_synth_library(7, 3, &Knobs::default()).expect("learn library");
+    let defaults = blobs::load(None, None).expect("default effort model");
+    let blobs = Blobs {
+        names: lib.names(),
+        library: lib.blob().expect("library blob"),
+        effort: defaults.effort,
+    };
+    eprintln!(
+        "learnt {} actions in {:.1} s",
+        blobs.names.len(),
+        t.elapsed().as_secs_f64()
+    );
     let mut q = Qemu::start(&QemuOptions::default()).expect("start QEMU");
     let mut dev = q.connect().expect("connect");
     upload_to(&mut dev, &blobs, true).expect("upload");

@@ -66,8 +66,13 @@ impl Blobs {
             let blob = store.active(&mut flash)?;
             match validate(kind, &mut flash, &blob) {
                 Ok(()) => {
-                    defmt::info!("{} loaded: {} bytes, crc {=u32:08x}, generation {}",
-                        kind, blob.header.len, blob.header.crc32, blob.header.generation);
+                    defmt::info!(
+                        "{} loaded: {} bytes, crc {=u32:08x}, generation {}",
+                        kind,
+                        blob.header.len,
+                        blob.header.crc32,
+                        blob.header.generation
+                    );
                     Some(blob)
                 }
                 Err(e) => {
@@ -122,7 +127,7 @@ impl Blobs {
         }
         let up = store_of(b.kind)
             .begin(&mut self.flash, b.len, b.crc32)
-            .map_err(|e| store_err(e))?;
+            .map_err(store_err)?;
         self.upload = Some((b.kind, up));
         Ok(())
     }
@@ -159,7 +164,7 @@ impl Blobs {
         };
         validate(k, &mut self.flash, &staged)
             .map_err(|e| err(ErrorCode::BlobInvalid, reason(e)))?;
-        let blob = store.commit(&mut self.flash, &up).map_err(|e| store_err(e))?;
+        let blob = store.commit(&mut self.flash, &up).map_err(store_err)?;
         match k {
             BlobKind::Library => self.library = Some(blob),
             BlobKind::Effort => self.effort = Some(blob),

@@ -21,8 +21,7 @@ pub const OUTBOX_CAPACITY: usize = 16;
 /// Link receiver → engine.
 pub static INBOX: Channel<CriticalSectionRawMutex, HostToDevice, INBOX_CAPACITY> = Channel::new();
 /// Engine → link transmitter.
-pub static OUTBOX: Channel<CriticalSectionRawMutex, DeviceToHost, OUTBOX_CAPACITY> =
-    Channel::new();
+pub static OUTBOX: Channel<CriticalSectionRawMutex, DeviceToHost, OUTBOX_CAPACITY> = Channel::new();
 
 /// Queues `msg` for the transmitter (waiting for room) and records the queue's high-water mark.
 pub async fn send_to_host(msg: DeviceToHost) {

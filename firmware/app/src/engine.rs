@@ -5,11 +5,11 @@
 //! unwrapped with the protocol's `SeqUnwrapper`/`TimeUnwrapper`, position and orientation
 //! dequantised with `Pose::position_m`/`Pose::orientation`, so both compute the same bits.
 
+use figurine_protocol::pose::{SeqUnwrapper, TimeUnwrapper};
 use figurine_protocol::{
     ActionEvent, BlobKind, Capacities, DeviceError, DeviceHello, DeviceToHost, ErrorCode,
     HostHello, HostToDevice, Pose, PROTOCOL_VERSION,
 };
-use figurine_protocol::pose::{SeqUnwrapper, TimeUnwrapper};
 use figurine_recognizer::bayes::MAX_EFFORT_FEATURES;
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_EDITS, MAX_POSITIONS};
 use figurine_recognizer::{Recognizer, Sample};
@@ -90,7 +90,9 @@ impl Engine {
     async fn pose(&mut self, p: &Pose) {
         let seq = self.seq.unwrap(p.seq);
         let t_us = self.time.unwrap(p.t_us);
-        let gap = self.last_seq.is_some_and(|last| seq != last.wrapping_add(1));
+        let gap = self
+            .last_seq
+            .is_some_and(|last| seq != last.wrapping_add(1));
         self.last_seq = Some(seq);
         let sample = Sample {
             seq,
@@ -160,7 +162,11 @@ impl Engine {
 
     async fn hello_from_host(&mut self, h: HostHello) {
         if h.protocol_version != PROTOCOL_VERSION {
-            defmt::warn!("host speaks protocol {}, we speak {}", h.protocol_version, PROTOCOL_VERSION);
+            defmt::warn!(
+                "host speaks protocol {}, we speak {}",
+                h.protocol_version,
+                PROTOCOL_VERSION
+            );
             send_to_host(DeviceToHost::Error(DeviceError {
                 code: ErrorCode::VersionMismatch,
                 detail: u32::from(PROTOCOL_VERSION),
@@ -188,10 +194,16 @@ impl Engine {
             HostToDevice::Ping(v) => DeviceToHost::Pong(v),
             HostToDevice::GetStats => {
                 let s = stats::snapshot();
-                let mean = self.total_cycles.checked_div(u64::from(s.samples)).unwrap_or(0);
+                let mean = self
+                    .total_cycles
+                    .checked_div(u64::from(s.samples))
+                    .unwrap_or(0);
                 defmt::info!(
                     "stats: {} samples, {} cycles total, {} mean, {} worst",
-                    s.samples, self.total_cycles, mean, s.worst_sample_cycles
+                    s.samples,
+                    self.total_cycles,
+                    mean,
+                    s.worst_sample_cycles
                 );
                 DeviceToHost::Stats(s)
             }

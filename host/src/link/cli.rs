@@ -160,7 +160,10 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         &mut dev,
         &log,
         &blobs.names,
-        ReplayOptions { speed: args.speed },
+        ReplayOptions {
+            speed: args.speed,
+            ..ReplayOptions::default()
+        },
         |rec| {
             if let Err(e) = write_event(&mut out, rec).and_then(|()| out.flush()) {
                 write_err.get_or_insert(e);

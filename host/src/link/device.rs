@@ -30,7 +30,7 @@ const HOST_BUILD: u32 = 0x0001_0000;
 
 /// What the reader thread hands over.
 enum Incoming {
-    Msg(DeviceToHost),
+    Msg(DeviceToHost, Instant),
     Closed(String),
 }
 
@@ -50,11 +50,14 @@ pub struct Device {
     reader: Option<JoinHandle<()>>,
     counters: Arc<HostRxCounters>,
     hello: DeviceHello,
-    /// Messages received while waiting for something else (events mostly).
-    backlog: VecDeque<DeviceToHost>,
+    /// Messages received while waiting for something else (events mostly), with the
+    /// moment the reader decoded them.
+    backlog: VecDeque<(DeviceToHost, Instant)>,
     next_ping: u32,
     /// Set when the device announced itself again without being asked: it rebooted.
     rebooted: bool,
+    /// When the message last taken from the reader arrived.
+    last_arrival: Instant,
 }
 
 fn reader_thread(
@@ -83,7 +86,7 @@ fn reader_thread(
             match decoder.feed::<DeviceToHost>(input) {
                 Decoded::NeedMore => break,
                 Decoded::Message { msg, remaining } => {
-                    if tx.send(Incoming::Msg(msg)).is_err() {
+                    if tx.send(Incoming::Msg(msg, Instant::now())).is_err() {
                         return;
                     }
                     input = remaining;
@@ -139,6 +142,7 @@ impl Device {
             backlog: VecDeque::new(),
             next_ping: 1,
             rebooted: false,
+            last_arrival: Instant::now(),
         };
         dev.handshake()?;
         Ok(dev)
@@ -233,7 +237,10 @@ impl Device {
     fn recv_until(&mut self, deadline: Instant) -> Result<DeviceToHost, LinkError> {
         let wait = deadline.saturating_duration_since(Instant::now());
         match self.rx.recv_timeout(wait) {
-            Ok(Incoming::Msg(m)) => Ok(self.accept(m)),
+            Ok(Incoming::Msg(m, at)) => {
+                self.last_arrival = at;
+                Ok(self.accept(m))
+            }
             Ok(Incoming::Closed(why)) => {
                 Err(LinkError::Disconnected(format!("{}: {why}", self.spec)))
             }
@@ -249,9 +256,9 @@ impl Device {
     fn drain_now(&mut self) -> Result<(), LinkError> {
         loop {
             match self.rx.try_recv() {
-                Ok(Incoming::Msg(m)) => {
+                Ok(Incoming::Msg(m, at)) => {
                     let m = self.accept(m);
-                    self.backlog.push_back(m);
+                    self.backlog.push_back((m, at));
                 }
                 Ok(Incoming::Closed(why)) => {
                     return Err(LinkError::Disconnected(format!("{}: {why}", self.spec)))
@@ -263,7 +270,7 @@ impl Device {
 
     /// Next message (from the backlog first), waiting at most `timeout`; `None` on timeout.
     pub fn poll(&mut self, timeout: Duration) -> Result<Option<DeviceToHost>, LinkError> {
-        if let Some(m) = self.backlog.pop_front() {
+        if let Some((m, _)) = self.backlog.pop_front() {
             return Ok(Some(m));
         }
         match self.recv_until(Instant::now() + timeout) {
@@ -275,11 +282,20 @@ impl Device {
 
     /// Action events received so far (removed from the backlog, in order).
     pub fn take_events(&mut self) -> Result<Vec<ActionEvent>, LinkError> {
+        Ok(self
+            .take_timed_events()?
+            .into_iter()
+            .map(|(e, _)| e)
+            .collect())
+    }
+
+    /// Like [`Device::take_events`], with the moment each event's frame was decoded.
+    pub fn take_timed_events(&mut self) -> Result<Vec<(ActionEvent, Instant)>, LinkError> {
         self.drain_now()?;
         let mut events = Vec::new();
-        self.backlog.retain(|m| match m {
+        self.backlog.retain(|(m, at)| match m {
             DeviceToHost::Event(e) => {
-                events.push(*e);
+                events.push((*e, *at));
                 false
             }
             _ => true,
@@ -306,7 +322,7 @@ impl Device {
                 DeviceToHost::Hello(_) => {
                     return Err(LinkError::Rebooted(self.spec.to_string()));
                 }
-                other => self.backlog.push_back(other),
+                other => self.backlog.push_back((other, self.last_arrival)),
             }
         }
     }
@@ -326,7 +342,7 @@ impl Device {
         if let Some(i) = self
             .backlog
             .iter()
-            .position(|m| matches!(m, DeviceToHost::Pong(p) if *p == v))
+            .position(|(m, _)| matches!(m, DeviceToHost::Pong(p) if *p == v))
         {
             self.backlog.remove(i);
             return Ok(());
@@ -337,7 +353,7 @@ impl Device {
                 DeviceToHost::Pong(p) if p == v => return Ok(()),
                 DeviceToHost::Hello(_) => return Err(LinkError::Rebooted(self.spec.to_string())),
                 DeviceToHost::Pong(_) => {}
-                other => self.backlog.push_back(other),
+                other => self.backlog.push_back((other, self.last_arrival)),
             }
         }
     }

@@ -19,11 +19,24 @@ use crate::poselog::PoseLog;
 pub const BATCHES_IN_FLIGHT: usize = 2;
 
 /// How to replay.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct ReplayOptions {
     /// Real-time factor (2.0 = twice as fast as recorded); `None` = as fast as the link and
     /// the device allow without dropping samples.
     pub speed: Option<f64>,
+    /// Pace by acknowledged batches so the device's queue never overflows (default). Off,
+    /// samples go out on the clock alone, and the device drops what it cannot keep up with
+    /// (counted in `Stats::samples_dropped`) — what benchmarks of the sustained rate need.
+    pub flow_control: bool,
+}
+
+impl Default for ReplayOptions {
+    fn default() -> Self {
+        ReplayOptions {
+            speed: None,
+            flow_control: true,
+        }
+    }
 }
 
 /// What a replay produced.
@@ -31,7 +44,7 @@ pub struct ReplayOptions {
 pub struct Replay {
     /// Events as JSON-lines records (names, log seconds, efforts q/127), like `simulate`.
     pub records: Vec<ActionRecord>,
-    /// The device's events as received, with their arrival time.
+    /// The device's events as received, with the moment the host decoded each.
     pub events: Vec<(ActionEvent, Instant)>,
     /// When each log sample was sent (`None`: the wire cannot carry it).
     pub sent_at: Vec<Option<Instant>>,
@@ -121,7 +134,7 @@ pub fn replay_log(
         out.sent_at[i] = Some(Instant::now());
         last_sent = i;
         in_batch += 1;
-        if in_batch == batch {
+        if opts.flow_control && in_batch == batch {
             in_batch = 0;
             in_flight.push_back(dev.ping_async()?);
             if in_flight.len() > BATCHES_IN_FLIGHT {

@@ -94,6 +94,14 @@ pub fn normalised_span(log: &PoseLog, t0: f64, t1: f64) -> Vec<Pt> {
     out
 }
 
+/// Reflects a normalised span left ↔ right (x → −x; rotations about y and z reverse).
+pub fn mirror_span(span: &mut [Pt]) {
+    for (p, q) in span.iter_mut() {
+        p[0] = -p[0];
+        *q = [q[0], q[1], -q[2], -q[3]];
+    }
+}
+
 fn extent(pts: &[Pt]) -> f64 {
     let n = pts.len().max(1) as f64;
     let c = [0, 1, 2].map(|k| pts.iter().map(|p| p.0[k]).sum::<f64>() / n);

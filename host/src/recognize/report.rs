@@ -45,7 +45,7 @@ fn bars(
         img,
         x,
         y + h + 16,
-        "FEATURE (0-24 MEAN, 25-49 STD); COLOURED = SELECTED",
+        "FEATURE (0-24 MEAN, 25-49 STD), COLOURED = SELECTED",
         1,
         INK,
     );

@@ -37,9 +37,13 @@ pub struct SceneArgs {
     /// Pose log (CSV) whose path is drawn as the doodle; its first sample is time 0.
     #[arg(long)]
     pub doodle: Option<PathBuf>,
-    /// Recognised actions (JSON lines of `figurine simulate`) for the timeline bar.
+    /// Recognised actions for the timeline bar: JSON lines of `figurine simulate`, or the
+    /// labels (JSON array) of `figurine synth`.
     #[arg(long)]
     pub events: Option<PathBuf>,
+    /// Toy metres → character metres for drawing the doodle (as `animate --world-scale`).
+    #[arg(long, default_value_t = super::from_clip::DEFAULT_DOODLE_SCALE)]
+    pub doodle_scale: f32,
     /// Start of the part to show, seconds.
     #[arg(long)]
     pub from: Option<f32>,
@@ -61,14 +65,20 @@ impl SceneArgs {
                 let log = crate::poselog::PoseLog::read_path(p)?;
                 let t0 = log.samples.first().map_or(0.0, |x| x.t);
                 s.doodle = super::from_clip::doodle_from_log(&log, t0);
+                super::from_clip::place_doodle(&mut s.doodle, self.doodle_scale, (0.0, 0.0), 0.0);
             }
             if let Some(p) = &self.events {
-                let ev = crate::events::read_events_path(p)?;
+                let ev = super::from_clip::read_actions(p)?;
                 s.timeline = super::from_clip::timeline_from_events(&ev, 0.0);
             }
             s
         } else {
-            load_scene(&self.anim, self.doodle.as_deref(), self.events.as_deref())?
+            load_scene(
+                &self.anim,
+                self.doodle.as_deref(),
+                self.events.as_deref(),
+                self.doodle_scale,
+            )?
         };
         let scene = if self.from.is_some() || self.to.is_some() {
             slice_scene(
@@ -140,12 +150,25 @@ pub struct ViewArgs {
     /// Initial window size in pixels, `WxH`.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
+    /// Close the window by itself after this many seconds (smoke tests, timed demos).
+    #[arg(long)]
+    pub quit_after: Option<f32>,
 }
 
 /// Runs `figurine view` (blocks until the window closes).
 pub fn run_view(args: &ViewArgs) -> anyhow::Result<()> {
     let scene = args.scene.load()?;
-    super::viewer::run_viewer(super::viewer::ViewerSource::Clip(scene), args.size)?;
+    let quit_after = match args.quit_after {
+        Some(s) if s.is_finite() && s >= 0.0 => Some(std::time::Duration::from_secs_f32(s)),
+        Some(s) => anyhow::bail!("--quit-after must be a non-negative number of seconds, got {s}"),
+        None => None,
+    };
+    let opts = super::viewer::ViewerOptions {
+        size: args.size,
+        quit_after,
+    };
+    let report = super::viewer::run_viewer(super::viewer::ViewerSource::Clip(scene), opts)?;
+    eprintln!("figurine view: {} frames presented", report.frames);
     Ok(())
 }
 

@@ -10,6 +10,9 @@ use super::scene::{DoodlePoint, FramePose, Scene, Side};
 
 /// At most this many doodle segments are drawn; denser doodles are thinned by arc length.
 pub const MAX_DOODLE_SEGMENTS: usize = 600;
+/// The doodle is drawn from this many seconds before now to as many after (a long doodle in
+/// full would clutter the picture; the recent past and near future show where the toy went).
+pub const DOODLE_WINDOW_S: f32 = 3.0;
 
 /// One capsule: a limb (or a doodle segment, or a ball when both ends coincide).
 #[repr(C)]
@@ -231,6 +234,9 @@ impl Composer {
         let future = srgba(0.85, 0.7, 0.8, 1.0);
         for w in self.doodle.windows(2) {
             let (p, q) = (w[0], w[1]);
+            if q.t < t - DOODLE_WINDOW_S || p.t > t + DOODLE_WINDOW_S {
+                continue;
+            }
             capsules.push(Capsule {
                 a: p.pos.extend(r).to_array(),
                 b: q.pos.extend(0.0).to_array(),

@@ -15,7 +15,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::scene::{BoneSegment, DoodlePoint, FramePose, Scene, Side, TimelineSpan};
+use super::scene::{pose_bounds, BoneSegment, DoodlePoint, FramePose, Scene, Side, TimelineSpan};
 use crate::events::ActionRecord;
 use crate::motion::{Clip, Skeleton};
 use crate::poselog::PoseLog;
@@ -340,7 +340,7 @@ pub fn scene_from_clip(clip: &Clip) -> Scene {
             }
             FramePose {
                 segments,
-                facing: facing(&pts, &plan.left, &plan.right),
+                facing: facing(pts, &plan.left, &plan.right),
             }
         })
         .collect();
@@ -370,6 +370,72 @@ pub fn doodle_from_log(log: &PoseLog, t0: f64) -> Vec<DoodlePoint> {
         .collect()
 }
 
+/// Default doodle scale: toy metres → character metres, the same default as
+/// `figurine animate --world-scale` (a 15 cm figurine stands for a 1.7 m character).
+pub const DEFAULT_DOODLE_SCALE: f32 = crate::anim::trajectory::DEFAULT_WORLD_SCALE;
+
+/// Half-width of the window whose lowest toy height is the doodle's local "floor", seconds.
+const DOODLE_FLOOR_HALF_S: f32 = 1.5;
+/// Heights are drawn at this fraction of the horizontal scale: at 10× a hand gesture of
+/// 50 cm would tower 5 m over a 1.7 m character; at 0.3 of it, hops still read as arcs.
+pub const DOODLE_HEIGHT_FACTOR: f32 = 0.3;
+
+/// Lowest `y` within ±`half` seconds of each sample (sliding-window minimum, O(n)).
+fn local_floor(doodle: &[DoodlePoint], half: f32) -> Vec<f32> {
+    let mut out = Vec::with_capacity(doodle.len());
+    let mut window: std::collections::VecDeque<usize> = std::collections::VecDeque::new();
+    let mut next = 0;
+    for p in doodle {
+        while next < doodle.len() && doodle[next].t <= p.t + half {
+            while window
+                .back()
+                .is_some_and(|&k| doodle[k].pos.y >= doodle[next].pos.y)
+            {
+                window.pop_back();
+            }
+            window.push_back(next);
+            next += 1;
+        }
+        while window.front().is_some_and(|&k| doodle[k].t < p.t - half) {
+            window.pop_front();
+        }
+        out.push(window.front().map_or(p.pos.y, |&k| doodle[k].pos.y));
+    }
+    out
+}
+
+/// Places a toy-scale doodle in the animation's world the way the animation follows it: its
+/// first sample over the character's start (`anchor_xz`), horizontal offsets multiplied by
+/// `scale` (as `figurine animate` maps the ground path). Heights are taken above the toy's
+/// local floor (the lowest height within ±1.5 s), times `scale` × [`DOODLE_HEIGHT_FACTOR`],
+/// from the `ground`: hops show as arcs, while the hand slowly raising or lowering the toy
+/// between actions (which the animation ignores) does not lift the path into the sky.
+pub fn place_doodle(doodle: &mut [DoodlePoint], scale: f32, anchor_xz: (f32, f32), ground: f32) {
+    let Some(first) = doodle.first().map(|p| p.pos) else {
+        return;
+    };
+    let floor = local_floor(doodle, DOODLE_FLOOR_HALF_S);
+    for (p, low) in doodle.iter_mut().zip(floor) {
+        p.pos = Vec3::new(
+            anchor_xz.0 + (p.pos.x - first.x) * scale,
+            ground + (p.pos.y - low) * scale * DOODLE_HEIGHT_FACTOR,
+            anchor_xz.1 + (p.pos.z - first.z) * scale,
+        );
+    }
+}
+
+/// Reads recognised actions: JSON lines of `figurine simulate`, or (a file starting with `[`)
+/// the ground-truth labels of `figurine synth`, whose effort classes become ±0.8.
+pub fn read_actions(path: &Path) -> anyhow::Result<Vec<ActionRecord>> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    if text.trim_start().starts_with('[') {
+        crate::anim::cli::read_label_events(path)
+    } else {
+        Ok(crate::events::read_events(text.as_bytes(), path)?)
+    }
+}
+
 /// Timeline spans of recognised actions, times shifted by `-t0` seconds.
 pub fn timeline_from_events(events: &[ActionRecord], t0: f64) -> Vec<TimelineSpan> {
     events
@@ -385,11 +451,13 @@ pub fn timeline_from_events(events: &[ActionRecord], t0: f64) -> Vec<TimelineSpa
 
 /// Loads a BVH animation with an optional doodle log and event file into a scene. When a
 /// doodle is given, its first sample defines time 0 for the doodle and the events (they share
-/// the log's clock); otherwise event times are used as they are.
+/// the log's clock, and `figurine animate` starts its output there); otherwise event times
+/// are used as they are. The doodle is placed with [`place_doodle`] at `doodle_scale`.
 pub fn load_scene(
     bvh: &Path,
     doodle: Option<&Path>,
     events: Option<&Path>,
+    doodle_scale: f32,
 ) -> anyhow::Result<Scene> {
     let import = crate::motion::read_bvh_path(bvh)?;
     for note in &import.notes {
@@ -401,10 +469,21 @@ pub fn load_scene(
         let log = PoseLog::read_path(path)?;
         t0 = log.samples.first().map_or(0.0, |s| s.t);
         scene.doodle = doodle_from_log(&log, t0);
+        let anchor = scene
+            .frames
+            .first()
+            .and_then(pose_bounds)
+            .map_or((0.0, 0.0), |(lo, hi)| {
+                ((lo.x + hi.x) * 0.5, (lo.z + hi.z) * 0.5)
+            });
+        let ground = crate::render::camera::SceneMetrics::of(&scene).ground;
+        if !(doodle_scale.is_finite() && doodle_scale > 0.0) {
+            anyhow::bail!("doodle scale must be positive, got {doodle_scale}");
+        }
+        place_doodle(&mut scene.doodle, doodle_scale, anchor, ground);
     }
     if let Some(path) = events {
-        let ev = crate::events::read_events_path(path)?;
-        scene.timeline = timeline_from_events(&ev, t0);
+        scene.timeline = timeline_from_events(&read_actions(path)?, t0);
     }
     Ok(scene)
 }
@@ -563,6 +642,37 @@ Frame Time: 0.1
         // Root translation of 10 cm along file Y becomes -0.1 m along scene Z.
         let d = scene.frames[1].segments[0].start - f0.segments[0].start;
         assert!((d - Vec3::new(0.0, 0.0, -0.1)).length() < 1e-4, "{d}");
+    }
+
+    #[test]
+    fn doodle_placement_keeps_hops_and_drops_drift() {
+        // The hand lifts the toy by 1 m over 10 s while making a 0.1 m hop at t = 5 s.
+        let mut d: Vec<DoodlePoint> = (0..=1000)
+            .map(|i| {
+                let t = i as f32 * 0.01;
+                let hop = if (4.8..5.2).contains(&t) {
+                    0.1 * (1.0 - ((t - 5.0) / 0.2).powi(2))
+                } else {
+                    0.0
+                };
+                DoodlePoint {
+                    t,
+                    pos: Vec3::new(1.0 + t * 0.01, 0.5 + t * 0.1 + hop, 2.0),
+                }
+            })
+            .collect();
+        place_doodle(&mut d, 10.0, (3.0, 4.0), -0.5);
+        assert!(
+            (d[0].pos - Vec3::new(3.0, -0.5, 4.0)).length() < 1e-4,
+            "{}",
+            d[0].pos
+        );
+        let top = d.iter().map(|p| p.pos.y).fold(f32::MIN, f32::max);
+        // The hop (0.3 m drawn) plus at most the drift within the window.
+        assert!(top > -0.3 && top < 0.5, "top {top}");
+        assert!((d[1000].pos.x - 4.0).abs() < 1e-3);
+        let floor = local_floor(&[], 1.0);
+        assert!(floor.is_empty());
     }
 
     #[test]

@@ -342,17 +342,17 @@ impl SceneRenderer {
     }
 
     /// Records the drawing of `frame` into `encoder`: clears and renders into the multisampled
-    /// `msaa` view, resolving into `resolve`; `depth` must match `msaa` in size and samples.
+    /// `attachments`, resolving into `resolve` (same size, the pipelines' colour format).
     pub fn draw(
         &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        msaa: &wgpu::TextureView,
+        attachments: &Attachments,
         resolve: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
         frame: &FrameDraw,
     ) {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let (msaa, depth) = (&attachments.msaa, &attachments.depth);
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&frame.globals));
         self.capsules
             .upload(device, queue, bytemuck::cast_slice(&frame.capsules));

@@ -96,12 +96,10 @@ impl OffscreenRenderer {
             label: Some("offscreen frame"),
         });
         self.renderer.draw(
-            device,
-            &self.gpu.queue,
+            &self.gpu,
             &mut encoder,
-            &self.attachments.msaa,
+            &self.attachments,
             &self.resolve_view,
-            &self.attachments.depth,
             frame,
         );
         encoder.copy_texture_to_buffer(

@@ -290,12 +290,7 @@ pub fn overlay_rects(scene: &Scene, t: f32, width: u32, height: u32, extra: &str
 
 /// The span (if any) whose block contains pixel column `x` of a `width`-wide frame; used by the
 /// viewer to show what the mouse points at.
-pub fn span_at_pixel<'a>(
-    scene: &'a Scene,
-    x: f32,
-    width: u32,
-    height: u32,
-) -> Option<&'a TimelineSpan> {
+pub fn span_at_pixel(scene: &Scene, x: f32, width: u32, height: u32) -> Option<&TimelineSpan> {
     let [x0, _, x1, _] = OverlayLayout::new(width, height).bar;
     if x < x0 || x > x1 {
         return None;

@@ -80,7 +80,7 @@ pub fn gif_delay_cs(fps: f32) -> u16 {
 /// Times (seconds) of the frames of a `duration`-second clip at `fps`: 0, 1/fps, … up to the
 /// last frame not after the end; always at least one frame.
 pub fn frame_times(duration: f32, fps: f32) -> Vec<f32> {
-    if !(fps.is_finite() && fps > 0.0) || !duration.is_finite() || duration <= 0.0 {
+    if !(fps.is_finite() && fps > 0.0 && duration.is_finite() && duration > 0.0) {
         return vec![0.0];
     }
     let n = (duration * fps + 1e-3).floor() as usize + 1;
@@ -320,7 +320,10 @@ impl FrameSink for PngFolderSink {
     }
 }
 
-/// A 256-colour palette with a fast lookup from 5-bit-per-channel RGB.
+/// The GIF palette index that marks a pixel unchanged from the previous frame.
+pub const TRANSPARENT: u8 = 255;
+
+/// A 255-colour palette with a fast lookup from 5-bit-per-channel RGB.
 pub struct Palette {
     /// RGB triples.
     pub colours: Vec<u8>,
@@ -328,10 +331,12 @@ pub struct Palette {
 }
 
 impl Palette {
-    /// Trains a palette on sample RGBA pixels (NeuQuant) and builds the lookup table.
+    /// Trains a palette on sample RGBA pixels (NeuQuant, 255 colours) and builds the lookup
+    /// table; index [`TRANSPARENT`] is left free for "unchanged since the previous frame".
     pub fn train(rgba: &[u8]) -> Self {
-        let nq = color_quant::NeuQuant::new(10, 256, rgba);
-        let colours = nq.color_map_rgb();
+        let nq = color_quant::NeuQuant::new(10, 255, rgba);
+        let mut colours = nq.color_map_rgb();
+        colours.resize(256 * 3, 0);
         let mut lut = vec![0u8; 32 * 32 * 32];
         for (i, slot) in lut.iter_mut().enumerate() {
             let c = |shift: usize| (((i >> shift) & 31) * 255 / 31) as u8;
@@ -375,6 +380,8 @@ pub struct GifSink {
     delay: u16,
     path: PathBuf,
     size: (u16, u16),
+    /// Palette indices of the previous frame, to code unchanged pixels as transparent.
+    previous: Option<Vec<u8>>,
 }
 
 impl GifSink {
@@ -410,6 +417,7 @@ impl GifSink {
             delay: delay_cs,
             path: path.to_path_buf(),
             size: (w, h),
+            previous: None,
         })
     }
 }
@@ -417,7 +425,23 @@ impl GifSink {
 impl FrameSink for GifSink {
     fn push(&mut self, img: RgbaImage) -> Result<(), RenderError> {
         let indices = self.palette.map(&img);
-        let mut frame = gif::Frame::from_indexed_pixels(self.size.0, self.size.1, indices, None);
+        // Unchanged pixels become transparent over the kept previous frame: the static sky
+        // and overlay then cost almost nothing after LZW.
+        let (coded, transparent) = match &self.previous {
+            Some(prev) if prev.len() == indices.len() => (
+                indices
+                    .iter()
+                    .zip(prev)
+                    .map(|(&i, &p)| if i == p { TRANSPARENT } else { i })
+                    .collect(),
+                Some(TRANSPARENT),
+            ),
+            _ => (indices.clone(), None),
+        };
+        self.previous = Some(indices);
+        let mut frame =
+            gif::Frame::from_indexed_pixels(self.size.0, self.size.1, coded, transparent);
+        frame.dispose = gif::DisposalMethod::Keep;
         frame.delay = self.delay;
         self.encoder
             .write_frame(&frame)

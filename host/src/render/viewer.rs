@@ -41,6 +41,24 @@ pub enum ViewerSource {
     Live(LiveFeed),
 }
 
+/// How to open the viewer window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewerOptions {
+    /// Initial window size, pixels.
+    pub size: (u32, u32),
+    /// Close by itself after this long (smoke tests, timed demos); `None` = until closed.
+    pub quit_after: Option<std::time::Duration>,
+}
+
+impl Default for ViewerOptions {
+    fn default() -> Self {
+        ViewerOptions {
+            size: (1280, 720),
+            quit_after: None,
+        }
+    }
+}
+
 /// What a viewer session did, returned when its window closes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ViewerReport {
@@ -141,6 +159,7 @@ struct WindowGfx {
 struct App {
     source: ViewerSource,
     size: (u32, u32),
+    deadline: Option<Instant>,
     gfx: Option<WindowGfx>,
     state: ViewerState,
     plan: Option<CameraPlan>,
@@ -156,7 +175,8 @@ struct App {
 }
 
 impl App {
-    fn new(source: ViewerSource, size: (u32, u32)) -> Self {
+    fn new(source: ViewerSource, opts: ViewerOptions) -> Self {
+        let size = opts.size;
         let aspect = size.0.max(1) as f32 / size.1.max(1) as f32;
         let (state, plan, composer) = match &source {
             ViewerSource::Clip(scene) => {
@@ -180,6 +200,7 @@ impl App {
         App {
             source,
             size,
+            deadline: opts.quit_after.map(|d| Instant::now() + d),
             gfx: None,
             state,
             plan,
@@ -336,15 +357,8 @@ impl App {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("view"),
             });
-        g.renderer.draw(
-            &g.gpu.device,
-            &g.gpu.queue,
-            &mut encoder,
-            &g.attachments.msaa,
-            &view,
-            &g.attachments.depth,
-            &draw,
-        );
+        g.renderer
+            .draw(&g.gpu, &mut encoder, &g.attachments, &view, &draw);
         g.gpu.queue.submit([encoder.finish()]);
         g.window.pre_present_notify();
         g.gpu.queue.present(frame);
@@ -429,7 +443,7 @@ impl ApplicationHandler for App {
             }
             _ => {}
         }
-        if self.state.quit {
+        if self.state.quit || self.deadline.is_some_and(|d| Instant::now() >= d) {
             event_loop.exit();
         }
     }
@@ -441,9 +455,9 @@ impl ApplicationHandler for App {
     }
 }
 
-/// Opens a window showing `source` at `size` pixels and runs until it is closed. Must be
-/// called on the main thread. Live mode prints event-to-first-frame statistics on exit.
-pub fn run_viewer(source: ViewerSource, size: (u32, u32)) -> Result<ViewerReport, RenderError> {
+/// Opens a window showing `source` and runs until it is closed (or `opts.quit_after`). Must
+/// be called on the main thread. Live mode prints event-to-first-frame statistics on exit.
+pub fn run_viewer(source: ViewerSource, opts: ViewerOptions) -> Result<ViewerReport, RenderError> {
     if let ViewerSource::Clip(scene) = &source {
         scene.validate()?;
     }
@@ -453,7 +467,7 @@ pub fn run_viewer(source: ViewerSource, size: (u32, u32)) -> Result<ViewerReport
         ))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
-    let mut app = App::new(source, size);
+    let mut app = App::new(source, opts);
     event_loop
         .run_app(&mut app)
         .map_err(|e| RenderError::Window(e.to_string()))?;
@@ -475,8 +489,8 @@ pub fn run_viewer(source: ViewerSource, size: (u32, u32)) -> Result<ViewerReport
 }
 
 /// Convenience for puppetry: shows the poses pushed into `feed` (see [`LiveFeed`]).
-pub fn run_live_viewer(feed: LiveFeed, size: (u32, u32)) -> Result<ViewerReport, RenderError> {
-    run_viewer(ViewerSource::Live(feed), size)
+pub fn run_live_viewer(feed: LiveFeed, opts: ViewerOptions) -> Result<ViewerReport, RenderError> {
+    run_viewer(ViewerSource::Live(feed), opts)
 }
 
 #[cfg(test)]
@@ -512,10 +526,14 @@ mod tests {
     #[test]
     fn app_constructs_without_a_window() {
         let scene = walking_scene(2.0, 30.0, &FigureParams::default());
-        let app = App::new(ViewerSource::Clip(scene), (640, 360));
+        let opts = ViewerOptions {
+            size: (640, 360),
+            quit_after: None,
+        };
+        let app = App::new(ViewerSource::Clip(scene), opts);
         assert!(app.gfx.is_none());
         assert!((app.state.playback.duration - 2.0).abs() < 1e-4);
-        let live = App::new(ViewerSource::Live(LiveFeed::new()), (640, 360));
+        let live = App::new(ViewerSource::Live(LiveFeed::new()), opts);
         assert!(live.plan.is_none());
     }
 

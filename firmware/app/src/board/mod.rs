@@ -20,7 +20,10 @@ pub const LIBRARY_STORE: TwoSlotStore = TwoSlotStore::new(0, LIBRARY_SLOT);
 pub const EFFORT_STORE: TwoSlotStore = TwoSlotStore::new(2 * LIBRARY_SLOT, EFFORT_SLOT);
 /// Bytes of the store region the two stores use (fits both boards' STORE regions).
 pub const STORE_USED: u32 = 2 * LIBRARY_SLOT + 2 * EFFORT_SLOT;
-const _: () = assert!(STORE_USED as usize <= STORE_SIZE, "blob stores exceed the STORE region");
+const _: () = assert!(
+    STORE_USED as usize <= STORE_SIZE,
+    "blob stores exceed the STORE region"
+);
 
 #[cfg(all(feature = "qemu", feature = "nrf52840"))]
 compile_error!("choose one board: `qemu` (default) or `nrf52840` with --no-default-features");

@@ -108,7 +108,9 @@ impl NorFlash for Flash {
 
     fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
         embedded_storage::nor_flash::check_erase(self, from, to)?;
-        self.0.erase(STORE_BASE + from, STORE_BASE + to).map_err(kind)
+        self.0
+            .erase(STORE_BASE + from, STORE_BASE + to)
+            .map_err(kind)
     }
 
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {

@@ -68,6 +68,11 @@ impl Flash {
         }
     }
 
+    /// The power cut still to come, if any.
+    pub fn armed(&self) -> Option<Cut> {
+        self.cut
+    }
+
     fn word_ptr(offset: usize) -> *mut u32 {
         (BASE + offset) as *mut u32
     }
@@ -135,10 +140,17 @@ impl NorFlash for Flash {
         for (k, word) in bytes.chunks_exact(4).enumerate() {
             let value = u32::from_le_bytes([word[0], word[1], word[2], word[3]]);
             let at = offset as usize + 4 * k;
-            if let Some(cut) = self.cut.filter(|c| c.upload == self.erases && self.written >= c.after_bytes) {
+            if let Some(cut) = self
+                .cut
+                .filter(|c| c.upload == self.erases && self.written >= c.after_bytes)
+            {
                 Self::program(at, value | 0xFFFF_0000);
                 mark_cut_done();
-                defmt::warn!("power cut injected in upload {} after {} bytes", cut.upload, self.written);
+                defmt::warn!(
+                    "power cut injected in upload {} after {} bytes",
+                    cut.upload,
+                    self.written
+                );
                 cortex_m::peripheral::SCB::sys_reset();
             }
             Self::program(at, value);

@@ -82,15 +82,15 @@ pub fn init() -> Board {
     };
     DRIVER.start(&mut core.SYST);
     let (rx, tx) = uart::init(&mut core.NVIC);
-    let cut = fault_from_args();
-    if let Some(c) = &cut {
-        defmt::info!("fault injection armed: power cut in upload {} after {} bytes", c.upload, c.after_bytes);
+    let flash = Flash::new(fault_from_args());
+    if let Some(c) = flash.armed() {
+        defmt::info!(
+            "fault injection armed: power cut in upload {} after {} bytes",
+            c.upload,
+            c.after_bytes
+        );
     }
-    Board {
-        rx,
-        tx,
-        flash: Flash::new(cut),
-    }
+    Board { rx, tx, flash }
 }
 
 #[cortex_m_rt::exception]
