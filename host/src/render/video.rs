@@ -36,6 +36,8 @@ pub enum OutputKind {
     /// A folder of numbered PNG frames (an existing folder, a path ending in `/`, or a path
     /// without extension).
     PngFolder,
+    /// A file extension none of the above understands.
+    Unsupported,
 }
 
 impl OutputKind {
@@ -51,7 +53,8 @@ impl OutputKind {
             Some("gif") => OutputKind::Gif,
             Some("mp4" | "mov" | "mkv") => OutputKind::Video,
             Some("png") => OutputKind::Still,
-            _ => OutputKind::PngFolder,
+            None => OutputKind::PngFolder,
+            Some(_) => OutputKind::Unsupported,
         }
     }
 }
@@ -152,9 +155,20 @@ pub fn render_to_path(
 ) -> Result<RenderSummary, RenderError> {
     scene.validate()?;
     let started = Instant::now();
+    let kind = OutputKind::of(out);
+    if kind == OutputKind::Unsupported {
+        return Err(RenderError::Encode {
+            path: out.to_path_buf(),
+            reason: "unsupported output: use .gif, .mp4 (.mov, .mkv), .png (one still) or a \
+                     folder path ending in / (PNG frames)"
+                .into(),
+        });
+    }
+    if kind == OutputKind::Video && !ffmpeg_available() {
+        return Err(RenderError::NoFfmpeg);
+    }
     let mut renderer = OffscreenRenderer::new(opts.width, opts.height)?;
     let adapter = renderer.gpu().describe();
-    let kind = OutputKind::of(out);
     if kind == OutputKind::Still {
         let t = still_at.unwrap_or(scene.duration() * 0.5);
         let r0 = Instant::now();
@@ -191,7 +205,9 @@ pub fn render_to_path(
             )?)
         }
         OutputKind::Video => Box::new(FfmpegSink::spawn(out, opts.width, opts.height, fps)?),
-        OutputKind::PngFolder | OutputKind::Still => Box::new(PngFolderSink::create(out)?),
+        OutputKind::PngFolder | OutputKind::Still | OutputKind::Unsupported => {
+            Box::new(PngFolderSink::create(out)?)
+        }
     };
     let encoder = EncoderThread::start(sink);
     let mut frames = 0;
@@ -582,6 +598,8 @@ mod tests {
         assert_eq!(OutputKind::of(Path::new("a.png")), OutputKind::Still);
         assert_eq!(OutputKind::of(Path::new("frames/")), OutputKind::PngFolder);
         assert_eq!(OutputKind::of(Path::new("frames")), OutputKind::PngFolder);
+        assert_eq!(OutputKind::of(Path::new("a.webm")), OutputKind::Unsupported);
+        assert_eq!(OutputKind::of(Path::new("a.webm/")), OutputKind::PngFolder);
     }
 
     #[test]
