@@ -361,17 +361,14 @@ impl Palette {
         Palette { colours, lut }
     }
 
-    /// Palette indices of an RGBA image, with 4×4 ordered dithering to hide banding.
+    /// Palette indices of an RGBA image (nearest palette colour of each pixel's 5-bit RGB).
+    /// No dithering: the scene's flat colours and soft gradients quantise cleanly, and
+    /// undithered frames compress better.
     pub fn map(&self, img: &RgbaImage) -> Vec<u8> {
-        const BAYER: [i32; 16] = [0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5];
-        let w = img.width() as usize;
         img.as_raw()
             .chunks_exact(4)
-            .enumerate()
-            .map(|(k, px)| {
-                let (x, y) = (k % w, k / w);
-                let d = BAYER[(y & 3) * 4 + (x & 3)] - 8; // -8..7, a 5-bit step is 8
-                let q = |v: u8| ((i32::from(v) + d).clamp(0, 255) >> 3) as usize;
+            .map(|px| {
+                let q = |v: u8| usize::from(v >> 3);
                 self.lut[(q(px[0]) << 10) | (q(px[1]) << 5) | q(px[2])]
             })
             .collect()
