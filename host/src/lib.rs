@@ -5,7 +5,10 @@
 pub mod anim;
 pub mod data;
 pub mod events;
+pub mod graph;
+pub mod link;
 pub mod motion;
 pub mod poselog;
+pub mod recognize;
 pub mod render;
 pub mod synth;

@@ -257,41 +257,46 @@ fn cyclic_walk_plays_whole_cycles_without_skating() {
     if setup().is_none() {
         return;
     }
-    let (log, events) = doodle(
-        &[Seg {
-            action: "walk",
-            dur: 4.0,
-            speed: 0.12,
-            turn: 0.0,
-        }],
-        100.0,
-        3,
-        1.0,
-    );
-    let asm = run(&events, Some(&log));
-    let p = &asm.placements[0];
-    // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles.
-    assert_eq!(p.cycles, 4, "{}", p.path.length());
-    // Planted feet barely slide: horizontal speed of a foot during contact.
-    let legs = figurine_host::anim::contact::find_legs(&asm.clip);
-    let dt = asm.clip.frame_time;
-    let mut slide = Vec::new();
-    for (l, leg) in legs.iter().enumerate() {
-        for f in (p.start_frame + 5)..(p.end_frame - 5) {
-            if asm.contacts[l][f] && asm.contacts[l][f + 1] {
-                let a = asm.clip.joint_positions(f)[leg.ankle];
-                let b = asm.clip.joint_positions(f + 1)[leg.ankle];
-                slide.push(ground(b - a).length() / dt);
+    let seg = [Seg {
+        action: "walk",
+        dur: 4.0,
+        speed: 0.12,
+        turn: 0.0,
+    }];
+    for weight in [0.0, -0.9, 0.9] {
+        let (log, mut events) = doodle(&seg, 100.0, 3, 1.0);
+        events[0].weight = weight;
+        let asm = run(&events, Some(&log));
+        let p = &asm.placements[0];
+        // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles; a light
+        // walk takes shorter strides (more cycles), a strong one longer (fewer).
+        match weight {
+            w if w < 0.0 => assert!(p.cycles > 4, "{}", p.cycles),
+            w if w > 0.0 => assert!(p.cycles < 4, "{}", p.cycles),
+            _ => assert_eq!(p.cycles, 4, "{}", p.path.length()),
+        }
+        // Planted feet barely slide: horizontal ankle speed while in contact.
+        let legs = figurine_host::anim::contact::find_legs(&asm.clip);
+        let dt = asm.clip.frame_time;
+        let mut slide = Vec::new();
+        for (l, leg) in legs.iter().enumerate() {
+            for f in (p.start_frame + 5)..(p.end_frame - 5) {
+                if asm.contacts[l][f] && asm.contacts[l][f + 1] {
+                    let a = asm.clip.joint_positions(f)[leg.ankle];
+                    let b = asm.clip.joint_positions(f + 1)[leg.ankle];
+                    slide.push(ground(b - a).length() / dt);
+                }
             }
         }
+        slide.sort_by(f32::total_cmp);
+        let median = slide[slide.len() / 2];
+        eprintln!(
+            "walk Lw={weight}: {} cycles, contact frames {}, median planted-foot speed {median:.3} m/s",
+            p.cycles,
+            slide.len()
+        );
+        assert!(slide.len() > 20 && median < 0.25, "{median}");
     }
-    slide.sort_by(f32::total_cmp);
-    let median = slide[slide.len() / 2];
-    eprintln!(
-        "contact frames {}, median planted-foot speed {median:.3} m/s",
-        slide.len()
-    );
-    assert!(slide.len() > 20 && median < 0.25, "{median}");
 }
 
 fn single(action: &str, time: f64, weight: f64) -> Assembly {
@@ -338,31 +343,39 @@ fn strong_moves_wider_and_bends_lower_than_light() {
     for action in ["punch", "kick", "wave", "bow"] {
         let light = single(action, 0.0, -0.9);
         let strong = single(action, 0.0, 0.9);
-        // Amplitude: mean distance of the wrists and ankles from their start-of-action position.
+        // Amplitude: mean angle (rad) by which the arms' and legs' joints turn away from
+        // their pose at the action's start — what eq. 7 scales. (Positions would mix in the
+        // foot pinning, which holds planted feet whatever the amplitude.)
         let amp = |a: &Assembly| {
             let sk = &a.clip.skeleton;
-            let ends: Vec<usize> = ["right_wrist", "left_wrist", "right_ankle", "left_ankle"]
-                .iter()
-                .filter_map(|n| sk.find(n))
-                .collect();
-            let p0 = a.clip.joint_positions(a.placements[0].start_frame);
-            let r0 = p0[0];
+            let joints: Vec<usize> = [
+                "right_shoulder",
+                "right_elbow",
+                "left_shoulder",
+                "left_elbow",
+                "right_hip",
+                "right_knee",
+                "left_hip",
+                "left_knee",
+            ]
+            .iter()
+            .filter_map(|n| sk.find(n))
+            .collect();
+            let (s0, e0) = (a.placements[0].start_frame, a.placements[0].end_frame);
+            let q0 = &a.clip.frames[s0].rotations;
             let mut sum = 0.0;
-            let mut n = 0;
-            for f in a.placements[0].start_frame..=a.placements[0].end_frame {
-                let p = a.clip.joint_positions(f);
-                for &j in &ends {
-                    sum += ((p[j] - p[0]) - (p0[j] - r0)).length();
-                    n += 1;
+            for f in s0..=e0 {
+                for &j in &joints {
+                    sum += q0[j].angle_between(a.clip.frames[f].rotations[j]);
                 }
             }
-            sum / n as f32
+            sum / ((e0 - s0 + 1) * joints.len()) as f32
         };
         // Spine angle at the action's first frame, where rescaling (eq. 7, anchored at the
         // stage start) has not acted yet, so the difference is the reshaping's alone.
         let tilt = |a: &Assembly| spine_lean(&a.clip, a.placements[0].start_frame, Vec3::X);
         eprintln!(
-            "{action}: amplitude light {:.3} strong {:.3} m; forward spine lean light {:.1}° strong {:.1}°",
+            "{action}: amplitude light {:.3} strong {:.3} rad; forward spine lean light {:.1}° strong {:.1}°",
             amp(&light),
             amp(&strong),
             tilt(&light).to_degrees(),
@@ -545,4 +558,213 @@ fn random_synthetic_doodles_animate_within_bounds() {
             lowest_foot(&asm)
         );
     }
+}
+
+#[test]
+fn a_jump_travels_only_while_in_the_air() {
+    if setup().is_none() {
+        return;
+    }
+    let (log, events) = doodle(
+        &[Seg {
+            action: "jump",
+            dur: 1.8,
+            speed: 0.1,
+            turn: 0.0,
+        }],
+        100.0,
+        9,
+        1.0,
+    );
+    let asm = run(&events, Some(&log));
+    let p = &asm.placements[0];
+    let n = p.end_frame - p.start_frame;
+    let root = |f: usize| ground(asm.clip.frames[f].translations[0]);
+    // DeepMimic's jump crouches for its first ~35 % and lands in its last ~20 %.
+    let take_off = p.start_frame + n * 30 / 100;
+    let landed = p.end_frame - n * 15 / 100;
+    let before = (root(take_off) - root(p.start_frame)).length();
+    let after = (root(p.end_frame) - root(landed)).length();
+    let flight = (root(landed) - root(take_off)).length();
+    eprintln!("jump: path {:.2} m; root moves {before:.3} m before take-off, {flight:.2} m in the air, {after:.3} m after landing", p.path.length());
+    assert!(before < 0.1 && after < 0.1, "{before} {after}");
+    assert!(flight > 0.8 * p.path.length(), "{flight}");
+}
+
+#[test]
+fn unordered_overlapping_events_and_degenerate_doodles_still_animate() {
+    if setup().is_none() {
+        return;
+    }
+    let ev = |action: &str, start: f64, end: f64| ActionRecord {
+        action: action.into(),
+        start,
+        end,
+        time: f64::NAN,
+        weight: 3.0,
+        distance: 0,
+    };
+    // Out of order, overlapping, one with an absurd effort: sorted, chained, clamped.
+    let events = vec![
+        ev("kick", 2.0, 3.0),
+        ev("walk", 0.0, 2.5),
+        ev("punch", 2.9, 3.1),
+    ];
+    let one_sample = PoseLog {
+        samples: vec![PoseSample {
+            t: 0.0,
+            pos: [0.0, 1.0, 0.0],
+            quat: [1.0, 0.0, 0.0, 0.0],
+        }],
+    };
+    for log in [None, Some(&one_sample), Some(&PoseLog::default())] {
+        let asm = run(&events, log);
+        let names: Vec<&str> = asm.placements.iter().map(|p| p.action.as_str()).collect();
+        assert_eq!(names, ["walk", "kick", "punch"]);
+        for w in asm.placements.windows(2) {
+            assert!(
+                w[1].start_frame >= w[0].end_frame,
+                "{} overlaps {}",
+                w[1].action,
+                w[0].action
+            );
+        }
+        assert!(asm
+            .clip
+            .frames
+            .iter()
+            .all(|p| p.translations.iter().all(|t| t.is_finite())));
+        assert!(lowest_foot(&asm) >= -1e-3);
+    }
+}
+
+#[test]
+fn cli_reports_malformed_inputs_with_file_and_line() {
+    let dir = out_dir();
+    let bad_events = dir.join("bad_events.jsonl");
+    std::fs::write(
+        &bad_events,
+        "{\"action\":\"walk\",\"start\":0,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}\n{\"action\":\"walk\",\"start\":\n",
+    )
+    .unwrap();
+    let bad_lib = dir.join("bad_clips.json");
+    std::fs::write(
+        &bad_lib,
+        "{\n  \"version\": 1,\n  \"actions\": {\n    \"walk\": { \"file\": }\n  }\n}\n",
+    )
+    .unwrap();
+    let good_events = dir.join("good_events.jsonl");
+    std::fs::write(
+        &good_events,
+        "{\"action\":\"walk\",\"start\":0,\"end\":1,\"time\":0,\"weight\":0,\"distance\":0}\n",
+    )
+    .unwrap();
+    let bad_log = dir.join("bad_doodle.csv");
+    std::fs::write(
+        &bad_log,
+        "t,x,y,z,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.1,zero,0,0,1,0,0,0\n",
+    )
+    .unwrap();
+    let cases: [(Vec<&std::ffi::OsStr>, String); 3] = [
+        (
+            vec![bad_events.as_os_str()],
+            format!("{}:2:", bad_events.display()),
+        ),
+        (
+            vec![
+                good_events.as_os_str(),
+                "--clips".as_ref(),
+                bad_lib.as_os_str(),
+            ],
+            format!("{}:4:", bad_lib.display()),
+        ),
+        (
+            vec![
+                good_events.as_os_str(),
+                "--doodle".as_ref(),
+                bad_log.as_os_str(),
+            ],
+            format!("{}:3:", bad_log.display()),
+        ),
+    ];
+    for (args, expect) in cases {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_figurine"))
+            .args(["animate", "--out"])
+            .arg(dir.join("never.bvh"))
+            .arg("--events")
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(err.contains(&expect), "expected {expect} in: {err}");
+    }
+}
+
+#[test]
+fn animate_recognises_a_log_itself() {
+    if setup().is_none() {
+        return;
+    }
+    let exe = env!("CARGO_BIN_EXE_figurine");
+    let dir = out_dir().join("log_mode");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run_ok = |args: &[&std::ffi::OsStr]| {
+        let out = std::process::Command::new(exe).args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{:?}: {}",
+            args,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let ex = dir.join("ex");
+    let lib = dir.join("lib.json");
+    let log = dir.join("jump.csv");
+    let bvh = dir.join("jump.bvh");
+    run_ok(&[
+        "synth".as_ref(),
+        "examples".as_ref(),
+        "--action".as_ref(),
+        "jump".as_ref(),
+        "--seed".as_ref(),
+        "1".as_ref(),
+        "--out".as_ref(),
+        ex.as_os_str(),
+    ]);
+    let mut learn: Vec<std::ffi::OsString> = vec![
+        "learn".into(),
+        "--library".into(),
+        lib.clone().into(),
+        "--name".into(),
+        "jump".into(),
+    ];
+    for k in 1..=3 {
+        learn.push(ex.join(format!("jump_{k}.csv")).into());
+    }
+    run_ok(&learn.iter().map(|s| s.as_os_str()).collect::<Vec<_>>());
+    run_ok(&[
+        "synth".as_ref(),
+        "gesture".as_ref(),
+        "--action".as_ref(),
+        "jump".as_ref(),
+        "--seed".as_ref(),
+        "4".as_ref(),
+        "--out".as_ref(),
+        log.as_os_str(),
+    ]);
+    let stdout = run_ok(&[
+        "animate".as_ref(),
+        "--library".as_ref(),
+        lib.as_os_str(),
+        log.as_os_str(),
+        "--out".as_ref(),
+        bvh.as_os_str(),
+    ]);
+    eprintln!("{stdout}");
+    assert!(stdout.contains("jump"), "{stdout}");
+    let clip = figurine_host::motion::read_bvh_path(&bvh).unwrap().clip;
+    assert!(clip.len() > 30);
 }

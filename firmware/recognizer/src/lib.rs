@@ -1,3 +1,86 @@
-//! figurine's online recognizer (work in progress in this commit).
+//! figurine's online recognizer: which actions a toy figurine was made to do, and how.
+//!
+//! `no_std`, no allocator, no panics on any input, no clock: samples come in with their
+//! sequence numbers and timestamps ([`Sample`]), recognised actions go out as
+//! [`ActionEvent`]s with Laban Time and Weight efforts. The same code runs on the MCU and in
+//! host simulation, and all float math goes through [`fmath`] (libm), so both compute the
+//! same bits.
+//!
+//! Stages, one module each, in data-flow order:
+//! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
+//! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
+//! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision) →
+//! [`features`] (50 Laban features) → [`bayes`] (naive Bayes Time/Weight). [`frontend`] and
+//! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
+//!
+//! # Capacities and RAM (with 32 actions loaded)
+//! | constant | value | RAM |
+//! |---|---|---|
+//! | [`pattern::MAX_ACTIONS`] | 32 actions | 64 B of record offsets (patterns stay in flash) |
+//! | [`pattern::MAX_POSITIONS`] | 32 tokens per pattern | blob ≤ [`pattern::MAX_LIBRARY_BYTES`] (flash) |
+//! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 4 × 8 B = 1 KiB of automaton state |
+//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.1 KiB (features per run) |
+//! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
+//! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
+//!
+//! Latency: the filter adds 50 ms; an action is committed [`segment::PAUSE_US`] after the
+//! figurine stops, or [`segment::LOOKAHEAD_TOKENS`] tokens after it ends when actions follow
+//! each other without a pause.
 #![no_std]
 #![forbid(unsafe_code)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod automaton;
+pub mod bayes;
+pub mod features;
+pub mod filter;
+pub mod fmath;
+pub mod frame;
+pub mod frontend;
+pub mod history;
+pub mod intake;
+pub mod pattern;
+pub mod recognizer;
+pub mod segment;
+pub mod token;
+
+pub use bayes::EffortModel;
+pub use intake::Sample;
+pub use pattern::Library;
+pub use recognizer::{ActionEvent, Recognizer, Stats};
+
+/// Why a library or effort blob was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Error {
+    /// The blob ends early.
+    Truncated,
+    /// The blob is larger than the format allows.
+    TooLarge,
+    /// Wrong magic bytes.
+    BadMagic,
+    /// Unsupported format version (the byte found).
+    Version(u8),
+    /// A count exceeds a compile-time capacity.
+    Capacity,
+    /// A field is inconsistent (what).
+    Invalid(&'static str),
+}
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Error::Truncated => f.write_str("blob truncated"),
+            Error::TooLarge => f.write_str("blob too large"),
+            Error::BadMagic => f.write_str("bad magic bytes"),
+            Error::Version(v) => write!(f, "unsupported format version {v}"),
+            Error::Capacity => f.write_str("capacity exceeded"),
+            Error::Invalid(what) => write!(f, "invalid {what}"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Error {}

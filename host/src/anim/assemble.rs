@@ -17,13 +17,15 @@
 //! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
-//! Finally ground penetration is removed with two-bone IK and foot contacts are reported.
+//! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted
+//! foot where its contact began, undoing slides from rescaling, path stretching and blends),
+//! and ground penetration is removed with two-bone IK.
 
 use std::collections::BTreeMap;
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::contact::{detect_contacts, find_legs, fix_ground, GroundFix};
+use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
 use super::effort::{apply_effort, Effort, EffortClip};
 use super::library::ActionClip;
 use super::phrasing::{detect_stages, Phrasing, Stage};
@@ -35,7 +37,7 @@ use crate::motion::{Clip, Pose};
 use crate::poselog::PoseLog;
 
 /// Fastest playback of a clip relative to its own speed (before effort retiming).
-pub const MAX_SPEEDUP: f32 = 2.5;
+pub const MAX_SPEEDUP: f32 = 3.0;
 
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,7 +92,8 @@ pub struct Assembly {
     pub clip: Clip,
     /// One placement per assembled event.
     pub placements: Vec<Placement>,
-    /// Per leg, per frame foot contact.
+    /// Per leg, per frame: the foot is planted (from the source clips' contacts at the frames'
+    /// source times), and was pinned there.
     pub contacts: Vec<Vec<bool>>,
     /// The ground pass's report.
     pub ground: GroundFix,
@@ -105,11 +108,20 @@ pub struct Assembly {
 struct Placed {
     f0: usize,
     poses: Vec<Pose>,
+    /// Per frame, per leg: the source clip's foot contact at the frame's source time.
+    contacts: Vec<Vec<bool>>,
 }
 
 impl Placed {
     fn f1(&self) -> usize {
         self.f0 + self.poses.len().saturating_sub(1)
+    }
+
+    fn contact_at(&self, f: usize) -> Vec<bool> {
+        let k = f
+            .saturating_sub(self.f0)
+            .min(self.contacts.len().saturating_sub(1));
+        self.contacts.get(k).cloned().unwrap_or_default()
     }
 
     fn at(&self, f: usize) -> &Pose {
@@ -186,6 +198,12 @@ pub fn assemble(
         .map(|c| c.clip.skeleton.clone())
         .unwrap_or_default();
     let mut phrasings: BTreeMap<String, Phrasing> = BTreeMap::new();
+    let mut source_contacts: BTreeMap<String, Vec<Vec<bool>>> = BTreeMap::new();
+    let legs = clips
+        .values()
+        .next()
+        .map(|c| find_legs(&c.clip))
+        .unwrap_or_default();
     let mut cursor = Cursor {
         pos: Vec2::ZERO,
         heading: initial_heading(doodle),
@@ -201,10 +219,6 @@ pub fn assemble(
         if !placed.is_empty() && f0 < last_f1 {
             f0 = last_f1; // overlapping events: the later one starts when the earlier ends
         }
-        // Never faster than MAX_SPEEDUP × the clip: a too-short event overruns into the pause
-        // after it (the next action waits if it must).
-        let min_len = (ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
-        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
         let phrasing = phrasings
             .entry(ev.action.clone())
             .or_insert_with(|| {
@@ -219,15 +233,34 @@ pub fn assemble(
             time: ev.time as f32,
             weight: ev.weight as f32,
         };
-        let ec = apply_effort(&ac.clip, &phrasing, effort, forward);
-        let duration = (f1 - f0) as f32 / fps;
+        let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
-            None => natural_path(ac, duration),
+            None => natural_path(ac, (ev.end - ev.start) as f32),
         };
-        let (poses, world_path, cycles) =
-            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0);
+        // Never faster than MAX_SPEEDUP × the clip (all its cycles): a too-short event overruns
+        // into the pause after it (the next action waits if it must).
+        let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
+        let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
+        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        let duration = (f1 - f0) as f32 / fps;
+        let (poses, world_path, cycles, src_times) =
+            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+        let src_contacts = source_contacts
+            .entry(ev.action.clone())
+            .or_insert_with(|| detect_contacts(&ac.clip, &legs))
+            .clone();
+        let contacts = src_times
+            .iter()
+            .map(|&t| {
+                let k = (t / ac.clip.frame_time.max(1e-6)).round().max(0.0) as usize;
+                src_contacts
+                    .iter()
+                    .map(|leg| leg.get(k).copied().unwrap_or(false))
+                    .collect()
+            })
+            .collect();
         let stages = ec
             .phrasing
             .spans
@@ -247,7 +280,11 @@ pub fn assemble(
             cycles,
             stages,
         });
-        placed.push(Placed { f0, poses });
+        placed.push(Placed {
+            f0,
+            poses,
+            contacts,
+        });
         last_f1 = f1;
     }
 
@@ -291,25 +328,36 @@ pub fn assemble(
         cuts.push((i, j));
     }
     let mut frames = Vec::with_capacity(total + 1);
+    let mut contact_frames: Vec<Vec<bool>> = Vec::with_capacity(total + 1);
     for f in 0..=total {
         // Which placed action owns frame f, or which transition covers it.
         let mut pose = placed[0].at(f).clone();
+        let mut contact = placed[0].contact_at(f);
         for (k, p) in placed.iter().enumerate() {
             let start_cut = if k == 0 { 0 } else { cuts[k - 1].1 };
             let end_cut = cuts.get(k).map(|c| c.0).unwrap_or(usize::MAX);
             if f >= start_cut && f <= end_cut {
                 pose = p.at(f).clone();
+                contact = p.contact_at(f);
                 break;
             }
             if let (Some(&(i, j)), Some(next)) = (cuts.get(k), placed.get(k + 1)) {
                 if f > i && f < j {
                     let u = smoothstep((f - i) as f32 / (j - i) as f32);
                     pose = blend_world(p.at(f), next.at(f), u);
+                    // A blended foot is planted only if both sides plant it.
+                    contact = p
+                        .contact_at(f)
+                        .iter()
+                        .zip(next.contact_at(f))
+                        .map(|(a, b)| *a && b)
+                        .collect();
                     break;
                 }
             }
         }
         frames.push(pose);
+        contact_frames.push(contact);
     }
     let mut clip = Clip {
         name: "figurine".into(),
@@ -317,9 +365,17 @@ pub fn assemble(
         frame_time: 1.0 / fps,
         frames,
     };
-    let legs = find_legs(&clip);
+    // Per leg, per frame.
+    let contacts: Vec<Vec<bool>> = (0..legs.len())
+        .map(|l| {
+            contact_frames
+                .iter()
+                .map(|c| c.get(l).copied().unwrap_or(false))
+                .collect()
+        })
+        .collect();
+    pin_feet(&mut clip, &legs, &contacts);
     let ground = fix_ground(&mut clip, &legs);
-    let contacts = detect_contacts(&clip, &legs);
     Ok(Assembly {
         clip,
         placements,
@@ -369,8 +425,8 @@ fn natural_path(ac: &ActionClip, duration: f32) -> Polyline {
     Polyline::new(vec![Vec2::ZERO, Vec2::new(len, 0.0)])
 }
 
-/// Places one action on `n + 1` output frames; returns the poses (root in world), the world
-/// path it followed, and the number of cycles. Updates the cursor.
+/// Places one action on `n + 1` output frames, playing `cycles` cycles; returns the poses (root in world), the world
+/// path it followed, the number of cycles and each frame's source time (s). Updates the cursor.
 fn place_action(
     ac: &ActionClip,
     ec: &EffortClip,
@@ -378,7 +434,8 @@ fn place_action(
     cursor: &mut Cursor,
     forward: Vec3,
     n: usize,
-) -> (Vec<Pose>, Polyline, usize) {
+    cycles: usize,
+) -> (Vec<Pose>, Polyline, usize, Vec<f32>) {
     let clip = &ec.clip;
     let src_root = clip.root_path();
     let r0 = src_root.first().copied().unwrap_or(Vec3::ZERO);
@@ -412,11 +469,6 @@ fn place_action(
     let r_start = yaw_between(clip_dir, start_heading);
     let base = cursor.pos;
     let cycle_len = along(rl - r0);
-    let cycles = if ac.cyclic && moving && cycle_len > 0.05 {
-        ((chunk.length() / cycle_len).round() as usize).max(1)
-    } else {
-        1
-    };
     let stretch = if cycles > 0 && cycle_len > 0.05 {
         chunk.length() / (cycles as f32 * cycle_len)
     } else {
@@ -433,6 +485,7 @@ fn place_action(
     let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
     let mut sigma_max = 0.0f32;
     let mut poses = Vec::with_capacity(n + 1);
+    let mut src_times = Vec::with_capacity(n + 1);
     for k in 0..=n {
         let u = k as f32 / n.max(1) as f32;
         let (w, cycle) = if ac.cyclic {
@@ -442,7 +495,9 @@ fn place_action(
         } else {
             (u, 0)
         };
-        let mut pose = ec.pose(w);
+        let src_t = ec.source_time(w);
+        src_times.push(src_t);
+        let mut pose = ec.clip.sample(src_t);
         let r = pose.translations[0];
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
@@ -490,7 +545,25 @@ fn place_action(
             cursor.heading = f.normalize();
         }
     }
-    (poses, world_path, cycles)
+    (poses, world_path, cycles, src_times)
+}
+
+/// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
+/// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
+/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put); 1 otherwise.
+fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
+    let root = ec.clip.root_path();
+    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
+        return 1;
+    };
+    let cycle_len = ground(rl - r0).length();
+    if ac.cyclic && ac.moving && chunk.length() > 0.05 && cycle_len > 0.05 {
+        let by_path = (chunk.length() / cycle_len).round() as usize;
+        let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
+        by_path.min(by_time).max(1)
+    } else {
+        1
+    }
 }
 
 /// Rotates a ground vector by a yaw quaternion.

@@ -16,10 +16,10 @@ use crate::poselog::PoseLog;
 /// `figurine animate`: assemble a character animation from recognised actions and the doodle.
 #[derive(clap::Args, Debug)]
 pub struct AnimateArgs {
-    /// Recognizer action library (used when recognising LOG).
+    /// Recognizer action library (used when recognising LOG; default: built-in).
     #[arg(long)]
     pub library: Option<PathBuf>,
-    /// Recognizer effort model (used when recognising LOG).
+    /// Recognizer effort model (used when recognising LOG; default: built-in).
     #[arg(long)]
     pub effort: Option<PathBuf>,
     /// Clip library (action → clip); the built-in DeepMimic library when absent.
@@ -107,6 +107,27 @@ pub enum ClipCommand {
         #[arg(long)]
         urdf: Option<PathBuf>,
     },
+    /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
+    /// to a PNG.
+    Plot {
+        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        clip: String,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        /// Clip library to look action names up in (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// URDF for DeepMimic files (default: the data folder's humanoid.urdf).
+        #[arg(long)]
+        urdf: Option<PathBuf>,
+        /// Length unit → metres (e.g. 0.01 for centimetre BVH).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f32,
+        /// The rig's facing direction in its clips, x,y,z (DeepMimic: 1,0,0).
+        #[arg(long, default_value = "1,0,0")]
+        forward: String,
+    },
 }
 
 /// Runs `figurine animate`.
@@ -114,20 +135,12 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
     let events = match (&args.events, &args.labels, &args.log) {
         (Some(e), _, _) => read_events_path(e)?,
         (None, Some(l), _) => read_label_events(l)?,
-        (None, None, Some(log)) => bail!(
-            "recognising {} inside `animate` needs the recognizer's simulate step, which this \
-             build does not include yet: run `figurine simulate --library LIB.json --jsonl {} > \
-             EVENTS.jsonl`, then `figurine animate --events EVENTS.jsonl --doodle {} --out …`",
-            log.display(),
-            log.display(),
-            log.display()
-        ),
+        (None, None, Some(log)) => recognise(log, args)?,
         (None, None, None) => bail!(
             "give --events EVENTS.jsonl (or --labels LABELS.json) and --doodle LOG.csv, or a LOG \
              to recognise"
         ),
     };
-    let _ = (&args.library, &args.effort); // used by the recognise path
     let doodle_path = args.doodle.as_ref().or(args.log.as_ref());
     let doodle = doodle_path.map(|p| PoseLog::read_path(p)).transpose()?;
     let library = match &args.clips {
@@ -151,6 +164,24 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
     }
     print_summary(&asm, &args.out, args.glb.as_deref());
     Ok(())
+}
+
+/// Runs the recognizer (the same code as `figurine simulate`) over a pose log.
+fn recognise(log: &Path, args: &AnimateArgs) -> anyhow::Result<Vec<ActionRecord>> {
+    use crate::recognize::simulate::{load_effort, load_library, simulate_log};
+    let (lib, blob) = load_library(args.library.as_deref())?;
+    let effort = load_effort(args.effort.as_deref())?;
+    let pose_log = PoseLog::read_path(log)?;
+    let sim = simulate_log(&pose_log, &lib.names(), &blob, Some(effort))
+        .with_context(|| format!("recognising {}", log.display()))?;
+    if sim.records.is_empty() {
+        bail!(
+            "the recognizer found no actions in {} (try `figurine tokens` / `figurine simulate` \
+             on it, or pass --events)",
+            log.display()
+        );
+    }
+    Ok(sim.records)
 }
 
 /// Draws the assembly's contact sheet: every action's path and a figure per action.
@@ -294,6 +325,33 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
                     s.end as f32 * c.frame_time
                 );
             }
+            Ok(())
+        }
+        ClipCommand::Plot {
+            clip,
+            out,
+            clips,
+            urdf,
+            scale,
+            forward,
+        } => {
+            let (mut c, _) = load_named_clip(clip, clips.as_deref(), urdf.as_deref())?;
+            c.scale_lengths(*scale);
+            let f: Vec<f32> = forward
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--forward {forward:?}: expected x,y,z"))?;
+            let fwd = match f.as_slice() {
+                [x, y, z] => glam::Vec3::new(*x, *y, *z),
+                _ => bail!("--forward {forward:?}: expected three numbers"),
+            };
+            let n = super::plot::MAX_FIGURES;
+            let frames: Vec<usize> = (0..n)
+                .map(|k| (k * c.len().saturating_sub(1)) / (n - 1))
+                .collect();
+            save_contact_sheet(&c, &frames, &[], fwd, out)?;
+            println!("{}: {} figures of {}", out.display(), n, c.name);
             Ok(())
         }
     }

@@ -110,6 +110,58 @@ pub fn detect_contacts(clip: &Clip, legs: &[Leg]) -> Vec<Vec<bool>> {
         .collect()
 }
 
+/// Frames over which a pinned foot eases in and out of its pin.
+pub const PIN_EASE_FRAMES: usize = 3;
+
+/// Pins planted feet: for every run of contact frames of a leg, the ankle is held (in the
+/// ground plane) where it was in the run's middle frame, by two-bone IK, easing in and out
+/// over [`PIN_EASE_FRAMES`] frames; its height stays the animation's. Unreachable pins are
+/// approached as far as the leg allows.
+pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
+    let sk = clip.skeleton.clone();
+    let n = clip.len();
+    for (leg, flags) in legs.iter().zip(contacts) {
+        let mut f = 0;
+        while f < n {
+            if !flags.get(f).copied().unwrap_or(false) {
+                f += 1;
+                continue;
+            }
+            let a = f;
+            while f < n && flags.get(f).copied().unwrap_or(false) {
+                f += 1;
+            }
+            let b = f - 1;
+            if b == a {
+                continue;
+            }
+            let mid = (a + b) / 2;
+            let pin = sk.positions(&clip.frames[mid])[leg.ankle];
+            let lo = a.saturating_sub(PIN_EASE_FRAMES);
+            let hi = (b + PIN_EASE_FRAMES).min(n - 1);
+            for g in lo..=hi {
+                let w = if g < a {
+                    (g + 1 - lo) as f32 / (a + 1 - lo) as f32
+                } else if g > b {
+                    (hi + 1 - g) as f32 / (hi + 1 - b) as f32
+                } else {
+                    1.0
+                };
+                let pose = &mut clip.frames[g];
+                let own = sk.positions(pose)[leg.ankle];
+                let target = Vec3::new(
+                    own.x + (pin.x - own.x) * w,
+                    own.y,
+                    own.z + (pin.z - own.z) * w,
+                );
+                if (target - own).length() > 1e-5 {
+                    two_bone_ik(&sk, pose, leg, target);
+                }
+            }
+        }
+    }
+}
+
 /// What the ground pass changed.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct GroundFix {

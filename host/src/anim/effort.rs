@@ -22,8 +22,9 @@
 //!
 //! Eq. 7 is applied with each stage's reference chained to the previous stage's rescaled end,
 //! so the rescaled motion stays continuous at stage boundaries. The root's orientation (the
-//! body's facing and balance) and its ground motion are left alone — trajectory transfer owns
-//! them; its height is rescaled like any translation.
+//! body's facing and balance) is left alone; its height is rescaled, and its ground travel
+//! too for cyclic clips so that the distance per cycle follows the rescaled stride. Feet that
+//! slide because of rescaling are pinned afterwards by the assembler's contact pass.
 
 use glam::{Quat, Vec3};
 
@@ -127,8 +128,15 @@ fn lookup(table: &[(f32, f32)], x: f32, inverse: bool) -> f32 {
 }
 
 /// Applies Time and Weight efforts to a clip with the given phrasing; `forward` is the rig's
-/// facing in its own frame (the clip library's `forward`), which defines the spine's bending axis.
-pub fn apply_effort(clip: &Clip, phrasing: &Phrasing, effort: Effort, forward: Vec3) -> EffortClip {
+/// facing in its own frame (the clip library's `forward`), which defines the spine's bending axis;
+/// `scale_travel` rescales the root's ground travel with the stride (cyclic clips).
+pub fn apply_effort(
+    clip: &Clip,
+    phrasing: &Phrasing,
+    effort: Effort,
+    forward: Vec3,
+    scale_travel: bool,
+) -> EffortClip {
     let e = effort.sanitized();
     let mut out = clip.clone();
     let n = clip.len();
@@ -151,7 +159,7 @@ pub fn apply_effort(clip: &Clip, phrasing: &Phrasing, effort: Effort, forward: V
             (s.start, s.end, time_part * c_w)
         })
         .collect();
-    rescale_stages(clip, &mut out, &factors);
+    rescale_stages(clip, &mut out, &factors, scale_travel);
     reshape(&mut out, e.weight, forward);
 
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
@@ -262,18 +270,32 @@ pub fn joint_speeds(clip: &Clip) -> Vec<f32> {
         .collect()
 }
 
-/// `q^c` for a unit quaternion along the shorter arc (any real c).
+/// Largest joint rotation (radians) away from the stage-start pose that rescaling may
+/// produce: amplifying a large swing past this would wrap round and flip the limb.
+pub const MAX_RESCALED_ANGLE: f32 = 2.6;
+
+/// `q^c` for a unit quaternion along the shorter arc (any real c), the result's angle capped
+/// at [`MAX_RESCALED_ANGLE`] when amplifying.
 fn quat_pow(q: Quat, c: f32) -> Quat {
     let q = if q.w < 0.0 { -q } else { q };
     let (axis, angle) = q.normalize().to_axis_angle();
     if angle.abs() < 1e-7 || !axis.is_finite() {
         return Quat::IDENTITY;
     }
-    Quat::from_axis_angle(axis, angle * c)
+    let scaled = angle * c;
+    let scaled = if c > 1.0 {
+        scaled.clamp(
+            -MAX_RESCALED_ANGLE.max(angle.abs()),
+            MAX_RESCALED_ANGLE.max(angle.abs()),
+        )
+    } else {
+        scaled
+    };
+    Quat::from_axis_angle(axis, scaled)
 }
 
 /// Eq. 7 per stage, references chained so the result is continuous.
-fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)]) {
+fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], travel: bool) {
     let joints = src.skeleton.len();
     let Some(first) = src.frames.first() else {
         return;
@@ -291,10 +313,17 @@ fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)]) {
                 if j == 0 {
                     // The root's orientation is the body's facing and balance: rescaling it
                     // would over- or under-turn the character and tip it over. Its height is
-                    // rescaled below like any translation.
+                    // rescaled like any translation; its ground travel only for cycles, where
+                    // the distance per cycle follows the rescaled stride (a light walk takes
+                    // shorter steps and, along a given path, more cycles).
                     let ts = ref_src.translations[0];
                     let tt = p.translations[0];
-                    o.translations[0].y = ref_out.translations[0].y + (tt.y - ts.y) * c;
+                    let scaled = ref_out.translations[0] + (tt - ts) * c;
+                    if travel {
+                        o.translations[0] = scaled;
+                    } else {
+                        o.translations[0].y = scaled.y;
+                    }
                     continue;
                 }
                 let qs = ref_src.rotations[j];
@@ -442,7 +471,7 @@ mod tests {
             return;
         };
         let ph = detect_stages(&c);
-        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X);
+        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X, false);
         for (a, b) in e.clip.frames.iter().zip(&c.frames) {
             for (qa, qb) in a.rotations.iter().zip(&b.rotations) {
                 assert!(qa.dot(*qb).abs() > 1.0 - 1e-6);
@@ -472,6 +501,7 @@ mod tests {
                     weight: 0.0,
                 },
                 Vec3::X,
+                false,
             );
             let (a, b) = e.stage_w(Stage::Execution).unwrap();
             b - a
@@ -498,6 +528,7 @@ mod tests {
                 weight: -1.0,
             },
             Vec3::X,
+            false,
         );
         let strong = apply_effort(
             &c,
@@ -507,6 +538,7 @@ mod tests {
                 weight: 1.0,
             },
             Vec3::X,
+            false,
         );
         let mid = c.len() / 2;
         assert!(spine_tilt(&strong.clip, mid) > spine_tilt(&light.clip, mid));

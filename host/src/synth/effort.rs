@@ -5,7 +5,7 @@
 //! gesture, e.g. one hop or one thrust):
 //!
 //! * **Time** sets the stroke's duration and its *onset*. Sudden strokes are short
-//!   (×0.42–0.7 of the neutral duration) and start explosively (the velocity profile rises
+//!   (×0.45–0.7 of the neutral duration) and start explosively (the velocity profile rises
 //!   almost at once); sustained strokes are long (×1.5–2.4) and ease in gently.
 //! * **Weight** sets the stroke's amplitude and its *ending*. Strong strokes are bigger
 //!   (×1.15–1.45), arrive with speed and stop in an impact (a damped overshoot), so their
@@ -102,7 +102,7 @@ impl Effort {
         let lift = rng.unit();
         let lerp = |lo: f64, hi: f64, u: f64| lo + (hi - lo) * u;
         let (time_factor, a) = match self.time {
-            TimeClass::Sudden => (lerp(0.42, 0.7, tf), lerp(1.0, 1.4, onset)),
+            TimeClass::Sudden => (lerp(0.45, 0.7, tf), lerp(1.0, 1.4, onset)),
             TimeClass::Sustained => (lerp(1.5, 2.4, tf), lerp(1.9, 2.9, onset)),
             TimeClass::Neutral => (lerp(0.85, 1.2, tf), lerp(1.4, 1.9, onset)),
         };
@@ -110,7 +110,13 @@ impl Effort {
             WeightClass::Strong => (
                 lerp(1.15, 1.45, amp),
                 lerp(1.0, 1.5, ending),
-                lerp(0.15, 0.3, ring),
+                // A sudden strong stroke hits (arrives at full speed); a sustained one presses
+                // on and stops firmly.
+                if self.time == TimeClass::Sustained {
+                    lerp(0.1, 0.2, ring)
+                } else {
+                    lerp(0.25, 0.4, ring)
+                },
                 lerp(0.8, 0.95, lift),
             ),
             WeightClass::Light => (
@@ -198,11 +204,26 @@ pub struct EffortShape {
     pub profile: Profile,
 }
 
+/// Added to the ending exponent of recovery strokes.
+pub const RECOVERY_EASE: f64 = 0.8;
+
 /// Number of points of the tabulated progress curve of a [`Profile`].
 const PROFILE_TABLE: usize = 257;
 
-/// Fraction of an impact stroke's time spent settling after the impact.
-const SETTLE_FRACTION: f64 = 0.22;
+/// Time an impact takes to settle, seconds: a hand stopping a toy hard decelerates within
+/// ~20 ms (the first quarter cycle) and the bounce dies out in ~0.1 s, however long the stroke.
+pub const IMPACT_SETTLE_S: f64 = 0.1;
+/// Bounds of the settle's share of a stroke (very short or very long strokes).
+const SETTLE_FRACTION_RANGE: (f64, f64) = (0.05, 0.5);
+
+/// Share of a stroke of `duration_s` seconds spent settling after an impact.
+fn settle_fraction(duration_s: f64) -> f64 {
+    if duration_s.is_finite() && duration_s > 0.0 {
+        (IMPACT_SETTLE_S / duration_s).clamp(SETTLE_FRACTION_RANGE.0, SETTLE_FRACTION_RANGE.1)
+    } else {
+        SETTLE_FRACTION_RANGE.1
+    }
+}
 /// Damped cycles of the settle (per settle phase).
 const SETTLE_CYCLES: f64 = 1.25;
 /// Exponential decay of the settle over its phase (e^-5 ≈ 0.7 % left).
@@ -212,7 +233,7 @@ const SETTLE_DECAY: f64 = 5.0;
 ///
 /// With `impact` > 0 the bump is cut at `1 − impact` of its course and stretched to reach the
 /// end point there, so the figurine arrives with speed and stops in a short damped bounce about
-/// the end point (position and velocity continuous; the deceleration is large but finite, so
+/// the end point lasting [`IMPACT_SETTLE_S`] whatever the stroke's length (position and velocity continuous; the deceleration is large but finite, so
 /// sampled accelerations do not grow without bound with the sample rate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Profile {
@@ -272,9 +293,15 @@ impl Profile {
         Self::new(2.0, 2.0, 0.0)
     }
 
-    /// The same onset and ending without the impact (e.g. for a recovery stroke).
+    /// The same onset and ending without the impact.
     pub fn without_impact(&self) -> Self {
         Self::new(self.a, self.b, 0.0)
+    }
+
+    /// The profile of a recovery stroke (wind-up, return): same onset, no impact, and an
+    /// ending eased by [`RECOVERY_EASE`] — the emphasis of a gesture is in its main strokes.
+    pub fn recovery(&self) -> Self {
+        Self::new(self.a, self.b + RECOVERY_EASE, 0.0)
     }
 
     /// Normalised integral of the kernel from 0 to `x`: cubic Hermite interpolation of the
@@ -295,8 +322,10 @@ impl Profile {
             + (f3 - f2) * m1
     }
 
-    /// Progress in [0, 1] (beyond 1 during an impact's overshoot) at normalised time `tau`.
-    pub fn progress(&self, tau: f64) -> f64 {
+    /// Progress in [0, 1] (beyond 1 during an impact's overshoot) at normalised time `tau` of
+    /// a stroke lasting `duration_s` seconds (which sets how much of it the impact's settle
+    /// takes).
+    pub fn progress(&self, tau: f64, duration_s: f64) -> f64 {
         let tau = if tau.is_finite() {
             tau.clamp(0.0, 1.0)
         } else {
@@ -305,7 +334,8 @@ impl Profile {
         if self.impact <= 0.0 {
             return self.cumulative(tau);
         }
-        let main = 1.0 - SETTLE_FRACTION;
+        let settle = settle_fraction(duration_s);
+        let main = 1.0 - settle;
         let cut = 1.0 - self.impact;
         let reach = self.cumulative(cut).max(1e-9);
         if tau < main {
@@ -313,8 +343,8 @@ impl Profile {
         }
         // Arrive at the end point with speed v0, then a damped bounce about it, in settle
         // time u ∈ [0, 1] (x(0) = 1, x'(0) = v0).
-        let v0 = kernel(self.a, self.b, cut) / self.norm * cut / main / reach * SETTLE_FRACTION;
-        let u = (tau - main) / SETTLE_FRACTION;
+        let v0 = kernel(self.a, self.b, cut) / self.norm * cut / main / reach * settle;
+        let u = (tau - main) / settle;
         let w = std::f64::consts::TAU * SETTLE_CYCLES;
         let spring = |u: f64| (-SETTLE_DECAY * u).exp() * (v0 / w) * (w * u).sin();
         // Remove the tiny residual at u = 1 with a blend that keeps the start untouched.
@@ -346,20 +376,20 @@ mod tests {
             let p = Profile::new(a, b, 0.0);
             let mut last = -1.0;
             for i in 0..=100 {
-                let s = p.progress(i as f64 / 100.0);
+                let s = p.progress(i as f64 / 100.0, 0.5);
                 assert!(s >= last - 1e-12);
                 last = s;
             }
-            assert!(p.progress(0.0).abs() < 1e-12);
-            assert!((p.progress(1.0) - 1.0).abs() < 1e-12);
+            assert!(p.progress(0.0, 0.5).abs() < 1e-12);
+            assert!((p.progress(1.0, 0.5) - 1.0).abs() < 1e-12);
         }
         let hit = Profile::new(1.2, 1.2, 0.25);
         let pts: Vec<f64> = (0..=1000)
-            .map(|i| hit.progress(i as f64 / 1000.0))
+            .map(|i| hit.progress(i as f64 / 1000.0, 0.5))
             .collect();
         let peak = pts.iter().cloned().fold(0.0, f64::max);
         assert!(peak > 1.001 && peak < 1.05, "{peak}");
-        assert!((hit.progress(1.0) - 1.0).abs() < 1e-12);
+        assert!((hit.progress(1.0, 0.5) - 1.0).abs() < 1e-12);
         // Continuous: no step larger than the fastest motion allows.
         let worst = pts
             .windows(2)
@@ -367,10 +397,10 @@ mod tests {
             .fold(0.0, f64::max);
         assert!(worst < 0.01, "{worst}");
         // Velocity continuous across the impact (within the discretisation).
-        let m = 1.0 - SETTLE_FRACTION;
+        let m = 1.0 - settle_fraction(0.5);
         let h = 1e-5;
-        let before = (hit.progress(m - h) - hit.progress(m - 2.0 * h)) / h;
-        let after = (hit.progress(m + 2.0 * h) - hit.progress(m + h)) / h;
+        let before = (hit.progress(m - h, 0.5) - hit.progress(m - 2.0 * h, 0.5)) / h;
+        let after = (hit.progress(m + 2.0 * h, 0.5) - hit.progress(m + h, 0.5)) / h;
         assert!(
             (before - after).abs() < 0.05 * before.abs(),
             "{before} vs {after}"
@@ -383,6 +413,6 @@ mod tests {
         let sudden = Effort::STATES[0].shape(&mut rng);
         let sustained = Effort::STATES[2].shape(&mut rng);
         assert!(sudden.time_factor < sustained.time_factor);
-        assert!(sudden.profile.progress(0.2) > sustained.profile.progress(0.2));
+        assert!(sudden.profile.progress(0.2, 0.3) > sustained.profile.progress(0.2, 1.0));
     }
 }

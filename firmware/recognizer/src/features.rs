@@ -1,0 +1,265 @@
+//! Stage 7 — Laban features (seed 000 §5.2), accumulated in constant memory.
+//!
+//! Per tick, 25 quantities: the magnitudes of the 6 object-frame components' velocity,
+//! acceleration and jerk (18: |vx| |vy| |vz| |ωx| |ωy| |ωz|, then the same for acceleration and
+//! jerk), and 7 world quantities: speed, |acceleration|, |jerk|, curvature, |torsion|, equi-affine
+//! velocity `|det(ṙ, r̈, r⃛)|^(1/6)` and the magnitude of its time derivative (equi-affine
+//! acceleration). Curvature and torsion are clamped to ±[`GEOM_CLAMP`] where speed vanishes.
+//!
+//! [`Accum`] keeps count, Σx and Σx² per quantity (one per token run: any segment's statistics
+//! are the sum of its runs' accumulators). [`segment_features`] turns an accumulator into the
+//! 50 features — mean then standard deviation of each quantity — in the log domain
+//! `ln(FEATURE_EPS + x)`, where Gaussian naive Bayes fits much better than on the raw,
+//! heavy-tailed, scale-multiplicative values.
+
+use crate::fmath;
+use crate::frame::Kinematics;
+use crate::intake::TICK_S;
+
+/// Per-tick quantities.
+pub const QUANTITIES: usize = 25;
+/// Segment features: mean and std of each quantity.
+pub const FEATURES: usize = 2 * QUANTITIES;
+/// Bound on |curvature| (1/m) and |torsion| (1/m).
+pub const GEOM_CLAMP: f32 = 1000.0;
+/// Offset inside the log transform of features.
+pub const FEATURE_EPS: f32 = 1e-4;
+
+/// Short names of the 25 quantities, in order (features `i` and `25 + i` are their mean and std).
+pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
+    "vel.left",
+    "vel.up",
+    "vel.front",
+    "angvel.x",
+    "angvel.y",
+    "angvel.z",
+    "acc.left",
+    "acc.up",
+    "acc.front",
+    "angacc.x",
+    "angacc.y",
+    "angacc.z",
+    "jerk.left",
+    "jerk.up",
+    "jerk.front",
+    "angjerk.x",
+    "angjerk.y",
+    "angjerk.z",
+    "world.speed",
+    "world.acc",
+    "world.jerk",
+    "curvature",
+    "torsion",
+    "equiaffine.vel",
+    "equiaffine.acc",
+];
+
+/// Sums over a set of ticks. 204 bytes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Accum {
+    /// Number of ticks.
+    pub n: u32,
+    /// Σ x per quantity.
+    pub sum: [f32; QUANTITIES],
+    /// Σ x² per quantity.
+    pub sum_sq: [f32; QUANTITIES],
+}
+
+impl Default for Accum {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Accum {
+    /// Empty sums.
+    pub const fn new() -> Self {
+        Accum {
+            n: 0,
+            sum: [0.0; QUANTITIES],
+            sum_sq: [0.0; QUANTITIES],
+        }
+    }
+
+    /// Adds one tick's quantities.
+    pub fn add(&mut self, q: &[f32; QUANTITIES]) {
+        self.n = self.n.saturating_add(1);
+        for ((s, s2), &x) in self.sum.iter_mut().zip(self.sum_sq.iter_mut()).zip(q) {
+            *s += x;
+            *s2 += x * x;
+        }
+    }
+
+    /// Adds another accumulator.
+    pub fn merge(&mut self, o: &Accum) {
+        self.n = self.n.saturating_add(o.n);
+        for (s, &x) in self.sum.iter_mut().zip(&o.sum) {
+            *s += x;
+        }
+        for (s, &x) in self.sum_sq.iter_mut().zip(&o.sum_sq) {
+            *s += x;
+        }
+    }
+}
+
+/// Scale exponent of each quantity: its value is divided by `mean speed` (linear rates) or
+/// multiplied by the path length (curvature, torsion), or divided by √path (equi-affine), so
+/// the features do not change when the same gesture is made larger or smaller. The mean world
+/// speed itself (feature 18) stays absolute: the one feature that knows the size.
+const SCALE_KIND: [u8; QUANTITIES] = [
+    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3,
+];
+
+/// The 50 log-domain, scale-free features of a segment (see [`SCALE_KIND`]).
+pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
+    let mut out = [fmath::ln(FEATURE_EPS); FEATURES];
+    if a.n == 0 {
+        return out;
+    }
+    let n = a.n as f32;
+    let speed = fmath::max(a.sum[18] / n, 1e-3);
+    let path = fmath::max(speed * n * TICK_S, 1e-3);
+    for i in 0..QUANTITIES {
+        let mean = a.sum[i] / n;
+        let var = fmath::max(a.sum_sq[i] / n - mean * mean, 0.0);
+        let k = match SCALE_KIND[i] {
+            1 => 1.0 / speed,
+            2 => path,
+            3 => 1.0 / fmath::sqrt(path),
+            _ => 1.0,
+        };
+        let k_mean = if i == 18 { 1.0 } else { k };
+        out[i] = fmath::ln(FEATURE_EPS + fmath::max(mean, 0.0) * k_mean);
+        out[QUANTITIES + i] = fmath::ln(FEATURE_EPS + fmath::sqrt(var) * k);
+    }
+    out
+}
+
+/// Computes per-tick quantities; remembers the previous equi-affine velocity.
+#[derive(Debug, Clone, Default)]
+pub struct FeatureExtractor {
+    prev_va: Option<f32>,
+}
+
+fn abs3(v: [f32; 3]) -> [f32; 3] {
+    [fmath::abs(v[0]), fmath::abs(v[1]), fmath::abs(v[2])]
+}
+
+impl FeatureExtractor {
+    /// A fresh extractor.
+    pub const fn new() -> Self {
+        FeatureExtractor { prev_va: None }
+    }
+
+    /// Forgets the previous tick (after a gap).
+    pub fn reset(&mut self) {
+        self.prev_va = None;
+    }
+
+    /// The 25 quantities of one tick (all finite and ≥ 0).
+    pub fn quantities(&mut self, k: &Kinematics) -> [f32; QUANTITIES] {
+        let mut q = [0.0f32; QUANTITIES];
+        let groups = [k.v, k.w, k.a, k.wa, k.j, k.wj];
+        for (g, v) in groups.iter().enumerate() {
+            let a = abs3(*v);
+            q[3 * g..3 * g + 3].copy_from_slice(&a);
+        }
+        let (v, a, j) = (k.world_v, k.world_a, k.world_j);
+        let speed = fmath::norm3(v);
+        let va_cross = fmath::cross3(v, a);
+        let cross_n = fmath::norm3(va_cross);
+        let det = fmath::dot3(va_cross, j);
+        let curvature = if speed > 1e-4 {
+            cross_n / (speed * speed * speed)
+        } else {
+            0.0
+        };
+        let torsion = if cross_n > 1e-6 {
+            det / (cross_n * cross_n)
+        } else {
+            0.0
+        };
+        let eq_v = fmath::sqrt(fmath::cbrt(fmath::abs(det)));
+        let eq_a = match self.prev_va {
+            Some(p) => fmath::abs(eq_v - p) / TICK_S,
+            None => 0.0,
+        };
+        self.prev_va = Some(eq_v);
+        q[18] = speed;
+        q[19] = fmath::norm3(a);
+        q[20] = fmath::norm3(j);
+        q[21] = fmath::clamp(curvature, 0.0, GEOM_CLAMP);
+        q[22] = fmath::clamp(fmath::abs(torsion), 0.0, GEOM_CLAMP);
+        q[23] = eq_v;
+        q[24] = eq_a;
+        for x in &mut q {
+            if !fmath::is_finite(*x) {
+                *x = 0.0;
+            }
+        }
+        q
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::intake::Tick;
+
+    fn kin(v: [f32; 3], a: [f32; 3], j: [f32; 3]) -> Kinematics {
+        Kinematics {
+            tick: Tick {
+                t_us: 0,
+                pos: [0.0; 3],
+                quat: [1.0, 0.0, 0.0, 0.0],
+                seq: 0,
+                sample_t_us: 0,
+            },
+            v,
+            a,
+            j,
+            w: [0.0; 3],
+            wa: [0.0; 3],
+            wj: [0.0; 3],
+            world_v: v,
+            world_a: a,
+            world_j: j,
+        }
+    }
+
+    #[test]
+    fn circle_has_curvature_one_over_radius() {
+        // Uniform circle radius 0.5 m at 2 m/s: a = v²/r towards the centre.
+        let mut fx = FeatureExtractor::new();
+        let q = fx.quantities(&kin([2.0, 0.0, 0.0], [0.0, 8.0, 0.0], [-32.0, 0.0, 0.0]));
+        assert!((q[21] - 2.0).abs() < 1e-4, "{}", q[21]);
+        assert!(q[22].abs() < 1e-4);
+        assert!((q[18] - 2.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn helix_has_torsion_and_equiaffine_velocity() {
+        let mut fx = FeatureExtractor::new();
+        let q = fx.quantities(&kin([0.0, 1.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]));
+        assert!(q[22] > 0.1);
+        assert!(q[23] > 0.0);
+        let q2 = fx.quantities(&kin([0.0; 3], [0.0; 3], [0.0; 3]));
+        assert_eq!(q2[21], 0.0);
+        assert!(q2[24] > 0.0, "equi-affine acceleration from the drop");
+    }
+
+    #[test]
+    fn accumulated_mean_and_std() {
+        let mut a = Accum::new();
+        let mut q = [0.0; QUANTITIES];
+        for x in [1.0f32, 3.0] {
+            q[0] = x;
+            a.add(&q);
+        }
+        let f = segment_features(&a);
+        // Relative to the (floored) mean speed of 1e-3 m/s.
+        assert!((f[0] - libm::logf(FEATURE_EPS + 2.0e3)).abs() < 1e-4);
+        assert!((f[QUANTITIES] - libm::logf(FEATURE_EPS + 1.0e3)).abs() < 1e-4);
+        assert_eq!(segment_features(&Accum::new())[3], libm::logf(FEATURE_EPS));
+    }
+}

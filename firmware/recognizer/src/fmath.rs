@@ -1,0 +1,174 @@
+//! The one place where the recognizer does non-trivial float math.
+//!
+//! Every routine calls `libm` explicitly (correctly rounded or close to it, deterministic,
+//! the same code on the host and on the Cortex-M4F), so host simulation and the MCU compute
+//! the same bits. std's float methods are never used in this crate. micromath was measured
+//! and rejected for this pipeline: its `sqrt(2.0)` returned 1.5 on this machine, which would
+//! move speed-relative token thresholds by up to 6 % and shift every feature using norms;
+//! the pipeline's float budget is small enough that libm's cost is acceptable.
+
+/// Square root (`libm::sqrtf`); negative or NaN input gives NaN as usual.
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
+/// Absolute value (bit operation, exact).
+#[inline]
+pub fn abs(x: f32) -> f32 {
+    libm::fabsf(x)
+}
+
+/// Natural logarithm.
+#[inline]
+pub fn ln(x: f32) -> f32 {
+    libm::logf(x)
+}
+
+/// e^x.
+#[inline]
+pub fn exp(x: f32) -> f32 {
+    libm::expf(x)
+}
+
+/// Hyperbolic tangent.
+#[inline]
+pub fn tanh(x: f32) -> f32 {
+    libm::tanhf(x)
+}
+
+/// Cube root.
+#[inline]
+pub fn cbrt(x: f32) -> f32 {
+    libm::cbrtf(x)
+}
+
+/// Rounds half away from zero.
+#[inline]
+pub fn round(x: f32) -> f32 {
+    libm::roundf(x)
+}
+
+/// True when `x` is neither NaN nor infinite (bit test, no std).
+#[inline]
+pub fn is_finite(x: f32) -> bool {
+    (x.to_bits() & 0x7f80_0000) != 0x7f80_0000
+}
+
+/// The larger of two values (NaN-ignoring like `fmaxf`).
+#[inline]
+pub fn max(a: f32, b: f32) -> f32 {
+    libm::fmaxf(a, b)
+}
+
+/// The smaller of two values (NaN-ignoring like `fminf`).
+#[inline]
+pub fn min(a: f32, b: f32) -> f32 {
+    libm::fminf(a, b)
+}
+
+/// Clamps `x` to `[lo, hi]`; NaN maps to `lo`.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x.is_nan() {
+        lo
+    } else {
+        min(max(x, lo), hi)
+    }
+}
+
+/// Euclidean norm of a 3-vector.
+#[inline]
+pub fn norm3(v: [f32; 3]) -> f32 {
+    sqrt(dot3(v, v))
+}
+
+/// Dot product of two 3-vectors.
+#[inline]
+pub fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Cross product of two 3-vectors.
+#[inline]
+pub fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Hamilton product of quaternions (w, x, y, z).
+#[inline]
+pub fn qmul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// Quaternion conjugate.
+#[inline]
+pub fn qconj(q: [f32; 4]) -> [f32; 4] {
+    [q[0], -q[1], -q[2], -q[3]]
+}
+
+/// Dot product of two quaternions.
+#[inline]
+pub fn qdot(a: [f32; 4], b: [f32; 4]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+/// Rotates world vector `v` into the frame of unit quaternion `q` (object→world), i.e. `q⁻¹ v q`.
+#[inline]
+pub fn rotate_inv(q: [f32; 4], v: [f32; 3]) -> [f32; 3] {
+    // R^T v with R from q; written out to avoid two quaternion products.
+    let [w, x, y, z] = q;
+    let (xx, yy, zz) = (x * x, y * y, z * z);
+    let (xy, xz, yz) = (x * y, x * z, y * z);
+    let (wx, wy, wz) = (w * x, w * y, w * z);
+    [
+        (1.0 - 2.0 * (yy + zz)) * v[0] + 2.0 * (xy + wz) * v[1] + 2.0 * (xz - wy) * v[2],
+        2.0 * (xy - wz) * v[0] + (1.0 - 2.0 * (xx + zz)) * v[1] + 2.0 * (yz + wx) * v[2],
+        2.0 * (xz + wy) * v[0] + 2.0 * (yz - wx) * v[1] + (1.0 - 2.0 * (xx + yy)) * v[2],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sqrt_is_accurate_where_micromath_is_not() {
+        assert_eq!(sqrt(2.0), core::f32::consts::SQRT_2);
+        assert_eq!(sqrt(4.0), 2.0);
+    }
+
+    #[test]
+    fn finiteness_by_bits() {
+        assert!(is_finite(1.0));
+        assert!(is_finite(-0.0));
+        assert!(!is_finite(f32::NAN));
+        assert!(!is_finite(f32::INFINITY));
+        assert!(!is_finite(f32::NEG_INFINITY));
+    }
+
+    #[test]
+    fn rotate_inv_undoes_a_yaw() {
+        // 90° about +Y maps object +Z (front) to world +X.
+        let h = core::f32::consts::FRAC_1_SQRT_2;
+        let q = [h, 0.0, h, 0.0];
+        let local = rotate_inv(q, [1.0, 0.0, 0.0]);
+        assert!((local[2] - 1.0).abs() < 1e-6, "{local:?}");
+        assert!(local[0].abs() < 1e-6 && local[1].abs() < 1e-6);
+    }
+
+    #[test]
+    fn clamp_maps_nan_low() {
+        assert_eq!(clamp(f32::NAN, -1.0, 1.0), -1.0);
+        assert_eq!(clamp(3.0, -1.0, 1.0), 1.0);
+    }
+}

@@ -1,0 +1,155 @@
+//! Stages 0–3 and 7 wired together: samples in, token runs with feature sums out.
+//!
+//! The front end validates and resamples samples ([`crate::intake`]), filters
+//! ([`crate::filter`]), moves to the object frame ([`crate::frame`]), tokenizes
+//! ([`crate::token`]) and accumulates the per-tick feature quantities ([`crate::features`])
+//! into the run each tick belongs to, keeping the recent runs in a [`History`]. Ticks of a
+//! token candidate are held in a side accumulator until the candidate is confirmed (they open
+//! the new run) or dropped (they go to the current run), so run boundaries and feature sums
+//! agree exactly. The host's learner and effort trainer use this same front end.
+
+use crate::features::{Accum, FeatureExtractor};
+use crate::filter::SavGol;
+use crate::frame::kinematics;
+use crate::history::History;
+use crate::intake::{Accept, Intake, IntakeCounters, Sample};
+use crate::token::{Token, TokenStep, Tokenizer};
+
+/// What one sample did to the run structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrontEvent {
+    /// A long gap restarted the pipeline: runs before it must not be joined to later ones.
+    Gap,
+    /// A new run opened (absolute history index); the previous run is now final.
+    Opened {
+        /// Absolute run index.
+        index: u32,
+        /// Its token.
+        token: Token,
+    },
+}
+
+/// Sample → token runs.
+#[derive(Debug, Clone, Default)]
+pub struct Frontend {
+    intake: Intake,
+    filter: SavGol,
+    features: FeatureExtractor,
+    tokenizer: Tokenizer,
+    history: History,
+    cand: Accum,
+    cand_start: (u32, u64),
+    cand_end: (u32, u64),
+    ticks: u32,
+    last_tick_us: u64,
+}
+
+impl Frontend {
+    /// A fresh front end.
+    pub const fn new() -> Self {
+        Frontend {
+            intake: Intake::new(),
+            filter: SavGol::new(),
+            features: FeatureExtractor::new(),
+            tokenizer: Tokenizer::new(),
+            history: History::new(),
+            cand: Accum::new(),
+            cand_start: (0, 0),
+            cand_end: (0, 0),
+            ticks: 0,
+            last_tick_us: 0,
+        }
+    }
+
+    /// Input counters.
+    pub fn counters(&self) -> IntakeCounters {
+        self.intake.counters()
+    }
+
+    /// Filtered ticks processed.
+    pub fn ticks(&self) -> u32 {
+        self.ticks
+    }
+
+    /// Time of the latest filtered tick, µs.
+    pub fn last_tick_us(&self) -> u64 {
+        self.last_tick_us
+    }
+
+    /// The run history.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Feeds one sample; `on` sees each run opening (at most a few per sample).
+    pub fn push(&mut self, s: &Sample, mut on: impl FnMut(&Self, FrontEvent)) {
+        match self.intake.push(s) {
+            Accept::Rejected => return,
+            Accept::Accepted => {}
+            Accept::AcceptedAfterGap => {
+                self.restart();
+                on(self, FrontEvent::Gap);
+            }
+        }
+        while let Some(tick) = self.intake.next_tick() {
+            let Some(sm) = self.filter.push(tick) else {
+                continue;
+            };
+            let k = kinematics(&sm);
+            let q = self.features.quantities(&k);
+            let at = (k.tick.seq, k.tick.sample_t_us);
+            self.ticks = self.ticks.saturating_add(1);
+            self.last_tick_us = k.tick.t_us;
+            match self.tokenizer.step(&k) {
+                TokenStep::Run => self.extend_current(&q, at),
+                TokenStep::Candidate => {
+                    if self.cand.n == 0 {
+                        self.cand_start = at;
+                    }
+                    self.cand_end = at;
+                    self.cand.add(&q);
+                }
+                TokenStep::BlipMerged { starts_candidate } => {
+                    let blip = core::mem::take(&mut self.cand);
+                    let blip_end = self.cand_end;
+                    if let Some(r) = self.history.newest_mut() {
+                        r.acc.merge(&blip);
+                        r.end = blip_end;
+                    }
+                    if starts_candidate {
+                        self.cand_start = at;
+                        self.cand_end = at;
+                        self.cand.add(&q);
+                    } else {
+                        self.extend_current(&q, at);
+                    }
+                }
+                TokenStep::NewToken { token } => {
+                    let start = if self.cand.n > 0 { self.cand_start } else { at };
+                    let mut acc = core::mem::take(&mut self.cand);
+                    acc.add(&q);
+                    let index = self.history.open(token, start, acc);
+                    if let Some(r) = self.history.newest_mut() {
+                        r.end = at;
+                    }
+                    on(self, FrontEvent::Opened { index, token });
+                }
+            }
+        }
+    }
+
+    fn extend_current(&mut self, q: &[f32; crate::features::QUANTITIES], at: (u32, u64)) {
+        if let Some(r) = self.history.newest_mut() {
+            r.acc.add(q);
+            r.end = at;
+        }
+    }
+
+    fn restart(&mut self) {
+        self.filter.reset();
+        self.features.reset();
+        self.tokenizer = Tokenizer::new();
+        self.history.clear();
+        self.cand = Accum::new();
+    }
+}

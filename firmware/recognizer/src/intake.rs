@@ -1,0 +1,331 @@
+//! Stage 0 — sample intake: validation, counters, and resampling onto the internal tick grid.
+//!
+//! Samples arrive at any rate (30–1000 Hz) with jitter. Every later stage runs on a fixed
+//! internal grid of [`TICK_US`] so that timestamps, not sample counts, define rates: a 30 Hz and
+//! a 240 Hz log of the same motion produce the same ticks up to interpolation error. Position is
+//! interpolated linearly, orientation by normalised lerp on the sign-aligned quaternion (q and −q
+//! are the same rotation; the sign is chosen to continue the previous sample's).
+//!
+//! Bad samples are counted in [`IntakeCounters`] and skipped; they never reach the filter.
+
+use crate::fmath;
+
+/// Internal tick period, µs (100 Hz grid).
+pub const TICK_US: u64 = 10_000;
+/// Internal tick period, seconds.
+pub const TICK_S: f32 = 0.01;
+/// A gap between accepted samples longer than this (µs) restarts the pipeline (tracker lost).
+pub const MAX_GAP_US: u64 = 250_000;
+/// A position step larger than this (m) between accepted samples is a glitch, skipped.
+pub const MAX_STEP_M: f32 = 0.5;
+/// Speed (m/s) above which a position step is a glitch (a toy does not move at 25 m/s).
+pub const MAX_SPEED_M_S: f32 = 25.0;
+/// Absolute coordinate bound (m); larger values are treated as garbage.
+pub const MAX_ABS_POS_M: f32 = 1.0e5;
+/// Squared quaternion norms below this are zero-length or corrupt: rejected, not renormalised.
+pub const QUAT_NORM2_MIN: f32 = 0.25;
+/// Upper bound of the accepted squared quaternion norm (see [`QUAT_NORM2_MIN`]).
+pub const QUAT_NORM2_MAX: f32 = 4.0;
+
+/// One pose sample as the recognizer receives it (from the wire or a log).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Caller's sequence number (wraps freely; only echoed in events).
+    pub seq: u32,
+    /// Timestamp, µs on the caller's clock; must strictly increase.
+    pub t_us: u64,
+    /// Position, metres, world frame, +Y up.
+    pub pos: [f32; 3],
+    /// Orientation (w, x, y, z), object → world; need not be normalised; q ≡ −q.
+    pub quat: [f32; 4],
+}
+
+/// Counts of skipped input, by reason.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IntakeCounters {
+    /// Samples accepted.
+    pub accepted: u32,
+    /// Samples with NaN or infinite values, or absurd coordinates.
+    pub non_finite: u32,
+    /// Samples with a zero-length or far-from-unit quaternion.
+    pub bad_quat: u32,
+    /// Samples whose time is not after the previous accepted sample (backwards or duplicate).
+    pub time_not_increasing: u32,
+    /// Samples whose position jumped implausibly far or fast.
+    pub jumps: u32,
+    /// Gaps longer than [`MAX_GAP_US`] (pipeline restarted; the sample itself is accepted).
+    pub gaps: u32,
+}
+
+impl IntakeCounters {
+    /// Total number of skipped samples.
+    pub fn skipped(&self) -> u32 {
+        self.non_finite
+            .saturating_add(self.bad_quat)
+            .saturating_add(self.time_not_increasing)
+            .saturating_add(self.jumps)
+    }
+}
+
+/// One point of the internal 100 Hz grid, with the input sample that closed it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tick {
+    /// Tick time, µs on the caller's clock.
+    pub t_us: u64,
+    /// Position relative to the stream's origin (first accepted sample), metres, world.
+    pub pos: [f32; 3],
+    /// Unit orientation, sign-continuous along the stream.
+    pub quat: [f32; 4],
+    /// Sequence number of the input sample at or after this tick.
+    pub seq: u32,
+    /// Time of that input sample, µs.
+    pub sample_t_us: u64,
+}
+
+/// What [`Intake::push`] did with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Accept {
+    /// The sample was skipped (see the counters).
+    Rejected,
+    /// Accepted; ticks up to it can be drained with [`Intake::next_tick`].
+    Accepted,
+    /// Accepted after a long gap: downstream state must be restarted before draining.
+    AcceptedAfterGap,
+}
+
+/// Validates samples and interpolates them onto the tick grid.
+#[derive(Debug, Clone)]
+pub struct Intake {
+    counters: IntakeCounters,
+    origin: [f32; 3],
+    prev: Option<(u64, [f32; 3], [f32; 4])>,
+    cur: Option<(u64, [f32; 3], [f32; 4], u32)>,
+    next_tick_us: u64,
+}
+
+impl Default for Intake {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Intake {
+    /// A fresh intake with zeroed counters.
+    pub const fn new() -> Self {
+        Intake {
+            counters: IntakeCounters {
+                accepted: 0,
+                non_finite: 0,
+                bad_quat: 0,
+                time_not_increasing: 0,
+                jumps: 0,
+                gaps: 0,
+            },
+            origin: [0.0; 3],
+            prev: None,
+            cur: None,
+            next_tick_us: 0,
+        }
+    }
+
+    /// The counters so far.
+    pub fn counters(&self) -> IntakeCounters {
+        self.counters
+    }
+
+    /// Offers one sample. On acceptance, call [`Intake::next_tick`] until it returns `None`.
+    pub fn push(&mut self, s: &Sample) -> Accept {
+        let finite = s
+            .pos
+            .iter()
+            .chain(s.quat.iter())
+            .all(|&v| fmath::is_finite(v))
+            && s.pos.iter().all(|&v| fmath::abs(v) <= MAX_ABS_POS_M);
+        if !finite {
+            self.counters.non_finite = self.counters.non_finite.saturating_add(1);
+            return Accept::Rejected;
+        }
+        let n2 = fmath::qdot(s.quat, s.quat);
+        if !(QUAT_NORM2_MIN..=QUAT_NORM2_MAX).contains(&n2) {
+            self.counters.bad_quat = self.counters.bad_quat.saturating_add(1);
+            return Accept::Rejected;
+        }
+        let inv = 1.0 / fmath::sqrt(n2);
+        let mut q = [
+            s.quat[0] * inv,
+            s.quat[1] * inv,
+            s.quat[2] * inv,
+            s.quat[3] * inv,
+        ];
+        let Some((t_prev, p_prev, q_prev, _)) = self.cur else {
+            self.start(s, q);
+            return Accept::Accepted;
+        };
+        if s.t_us <= t_prev {
+            self.counters.time_not_increasing = self.counters.time_not_increasing.saturating_add(1);
+            return Accept::Rejected;
+        }
+        let dt_us = s.t_us - t_prev;
+        if dt_us > MAX_GAP_US {
+            self.counters.gaps = self.counters.gaps.saturating_add(1);
+            self.start(s, q);
+            return Accept::AcceptedAfterGap;
+        }
+        let p = [
+            s.pos[0] - self.origin[0],
+            s.pos[1] - self.origin[1],
+            s.pos[2] - self.origin[2],
+        ];
+        let step = fmath::norm3([p[0] - p_prev[0], p[1] - p_prev[1], p[2] - p_prev[2]]);
+        let dt_s = dt_us as f32 * 1e-6;
+        if step > MAX_STEP_M || step > MAX_SPEED_M_S * dt_s {
+            self.counters.jumps = self.counters.jumps.saturating_add(1);
+            return Accept::Rejected;
+        }
+        if fmath::qdot(q, q_prev) < 0.0 {
+            q = [-q[0], -q[1], -q[2], -q[3]];
+        }
+        self.counters.accepted = self.counters.accepted.saturating_add(1);
+        self.prev = Some((t_prev, p_prev, q_prev));
+        self.cur = Some((s.t_us, p, q, s.seq));
+        Accept::Accepted
+    }
+
+    fn start(&mut self, s: &Sample, q: [f32; 4]) {
+        self.counters.accepted = self.counters.accepted.saturating_add(1);
+        self.origin = s.pos;
+        self.prev = None;
+        self.cur = Some((s.t_us, [0.0; 3], q, s.seq));
+        self.next_tick_us = s.t_us;
+    }
+
+    /// The next grid tick at or before the latest accepted sample, if any.
+    pub fn next_tick(&mut self) -> Option<Tick> {
+        let (t1, p1, q1, seq) = self.cur?;
+        if self.next_tick_us > t1 {
+            return None;
+        }
+        let t = self.next_tick_us;
+        self.next_tick_us = t.saturating_add(TICK_US);
+        let (pos, quat) = match self.prev {
+            Some((t0, p0, q0)) if t < t1 && t >= t0 => {
+                let a = (t - t0) as f32 / (t1 - t0) as f32;
+                let b = 1.0 - a;
+                let p = [
+                    b * p0[0] + a * p1[0],
+                    b * p0[1] + a * p1[1],
+                    b * p0[2] + a * p1[2],
+                ];
+                let mut q = [
+                    b * q0[0] + a * q1[0],
+                    b * q0[1] + a * q1[1],
+                    b * q0[2] + a * q1[2],
+                    b * q0[3] + a * q1[3],
+                ];
+                let n2 = fmath::qdot(q, q);
+                let inv = if n2 > 1e-12 {
+                    1.0 / fmath::sqrt(n2)
+                } else {
+                    1.0
+                };
+                for c in &mut q {
+                    *c *= inv;
+                }
+                (p, q)
+            }
+            _ => (p1, q1),
+        };
+        Some(Tick {
+            t_us: t,
+            pos,
+            quat,
+            seq,
+            sample_t_us: t1,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn s(seq: u32, t_us: u64, x: f32) -> Sample {
+        Sample {
+            seq,
+            t_us,
+            pos: [x, 1.0, 0.0],
+            quat: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+
+    fn drain(i: &mut Intake) -> usize {
+        let mut n = 0;
+        while i.next_tick().is_some() {
+            n += 1;
+        }
+        n
+    }
+
+    #[test]
+    fn bad_samples_are_counted_and_skipped() {
+        let mut i = Intake::new();
+        assert_eq!(i.push(&s(0, 1000, 0.0)), Accept::Accepted);
+        let mut nan = s(1, 2000, 0.0);
+        nan.pos[1] = f32::NAN;
+        assert_eq!(i.push(&nan), Accept::Rejected);
+        let mut zq = s(2, 3000, 0.0);
+        zq.quat = [0.0; 4];
+        assert_eq!(i.push(&zq), Accept::Rejected);
+        assert_eq!(i.push(&s(3, 1000, 0.0)), Accept::Rejected);
+        assert_eq!(i.push(&s(4, 500, 0.0)), Accept::Rejected);
+        assert_eq!(i.push(&s(5, 5000, 3.0)), Accept::Rejected);
+        assert_eq!(i.push(&s(6, 6000, 0.001)), Accept::Accepted);
+        let c = i.counters();
+        assert_eq!(
+            (c.non_finite, c.bad_quat, c.time_not_increasing, c.jumps),
+            (1, 1, 2, 1)
+        );
+        assert_eq!(c.accepted, 2);
+        assert_eq!(c.skipped(), 5);
+    }
+
+    #[test]
+    fn ticks_follow_time_not_sample_count() {
+        for rate in [30u64, 60, 240, 1000] {
+            let mut i = Intake::new();
+            let mut ticks = 0;
+            let period = 1_000_000 / rate;
+            let mut t = 0;
+            while t <= 1_000_000 {
+                i.push(&s(0, t, t as f32 * 1e-7));
+                ticks += drain(&mut i);
+                t += period;
+            }
+            assert!((99..=101).contains(&ticks), "{rate} Hz gave {ticks} ticks");
+        }
+    }
+
+    #[test]
+    fn interpolation_is_linear_in_position_and_origin_relative() {
+        let mut i = Intake::new();
+        i.push(&s(0, 0, 100.0));
+        drain(&mut i);
+        i.push(&s(1, 20_000, 100.2));
+        let t = i.next_tick().unwrap();
+        assert_eq!(t.t_us, 10_000);
+        assert!((t.pos[0] - 0.1).abs() < 1e-5, "{:?}", t.pos);
+        assert_eq!(t.seq, 1);
+    }
+
+    #[test]
+    fn long_gap_restarts() {
+        let mut i = Intake::new();
+        i.push(&s(0, 0, 0.0));
+        drain(&mut i);
+        assert_eq!(i.push(&s(1, 2_000_000, 5.0)), Accept::AcceptedAfterGap);
+        assert_eq!(i.counters().gaps, 1);
+        let t = i.next_tick().unwrap();
+        assert_eq!(t.t_us, 2_000_000);
+        assert_eq!(t.pos, [0.0; 3]);
+    }
+}

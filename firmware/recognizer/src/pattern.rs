@@ -1,0 +1,406 @@
+//! Stage 4 — action patterns in their compiled, device-side form.
+//!
+//! A pattern is a regular expression over tokens (`*`, `+`, `|`, groups), compiled on the host
+//! into a Glushkov automaton: one state per token occurrence ("position", at most
+//! [`MAX_POSITIONS`]) plus the initial state. State sets are `u64` bit masks: bit 0 is the
+//! initial state, bit `i` (1 ≤ i ≤ n) position `i`. The blob is read in place (from flash);
+//! nothing is copied into RAM except [`MAX_ACTIONS`] record offsets (64 bytes).
+//!
+//! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
+//! ```text
+//! 0   4   magic "FGL" + version byte (1)
+//! 4   1   n_actions (≤ MAX_ACTIONS)
+//! 5   3   reserved, zero
+//! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
+//! +0  1   n: positions (1 ≤ n ≤ MAX_POSITIONS)
+//! +1  1   max_edits: per-action edit bound (≤ MAX_EDITS, < min_len)
+//! +2  1   min_len: length of the shortest token string the pattern accepts (≥ 1)
+//! +3  1   flags: bit 0 = cyclic (the whole pattern repeats, e.g. `(uf~ df~)+`); others zero
+//! +4  8   last: accepting positions
+//! +12 8   shift: positions j ≥ 2 with j ∈ follow(j − 1)
+//! +20 8   loops: positions i with i ∈ follow(i)
+//! +28 8   extra: states whose follow set has more than {i, i + 1}
+//! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
+//!         `token::ANY_ROT` or `token::ANY_LIN`)
+//! +.. 8(n+1) follow set of each state 0..=n
+//! ```
+//! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
+//! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
+//! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
+
+use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
+use crate::Error;
+
+/// Maximum number of actions in a library.
+pub const MAX_ACTIONS: usize = 32;
+/// Maximum token positions in one pattern.
+pub const MAX_POSITIONS: usize = 32;
+/// Maximum edits per action.
+pub const MAX_EDITS: usize = 3;
+/// Library blob format version.
+pub const LIBRARY_VERSION: u8 = 1;
+/// Library blob header size, bytes.
+pub const LIBRARY_HEADER: usize = 8;
+/// Size of one action record with `n` positions, bytes.
+pub const fn record_size(n: usize) -> usize {
+    36 + 2 * n + 8 * (n + 1)
+}
+/// Largest valid library blob, bytes (11,656).
+pub const MAX_LIBRARY_BYTES: usize = LIBRARY_HEADER + MAX_ACTIONS * record_size(MAX_POSITIONS);
+
+fn rd_u64(b: &[u8], at: usize) -> Option<u64> {
+    let s = b.get(at..at + 8)?;
+    let mut a = [0u8; 8];
+    a.copy_from_slice(s);
+    Some(u64::from_le_bytes(a))
+}
+
+fn rd_u16(b: &[u8], at: usize) -> Option<u16> {
+    let s = b.get(at..at + 2)?;
+    Some(u16::from_le_bytes([s[0], s[1]]))
+}
+
+/// One action's compiled pattern, borrowed from the library blob.
+#[derive(Debug, Clone, Copy)]
+pub struct Pattern<'a> {
+    rec: &'a [u8],
+}
+
+impl<'a> Pattern<'a> {
+    /// Number of positions.
+    pub fn positions(&self) -> usize {
+        usize::from(self.rec.first().copied().unwrap_or(0))
+    }
+    /// Edit bound.
+    pub fn max_edits(&self) -> usize {
+        usize::from(self.rec.get(1).copied().unwrap_or(0))
+    }
+    /// Shortest accepted token string length.
+    pub fn min_len(&self) -> usize {
+        usize::from(self.rec.get(2).copied().unwrap_or(0))
+    }
+    /// Accepting positions.
+    pub fn last(&self) -> u64 {
+        rd_u64(self.rec, 4).unwrap_or(0)
+    }
+    fn shift(&self) -> u64 {
+        rd_u64(self.rec, 12).unwrap_or(0)
+    }
+    fn loops(&self) -> u64 {
+        rd_u64(self.rec, 20).unwrap_or(0)
+    }
+    fn extra(&self) -> u64 {
+        rd_u64(self.rec, 28).unwrap_or(0)
+    }
+    /// Symbol of position `i` (1-based); STILL (matches nothing) when out of range.
+    pub fn symbol(&self, i: usize) -> Symbol {
+        if i == 0 {
+            return STILL;
+        }
+        rd_u16(self.rec, 36 + 2 * (i - 1)).unwrap_or(STILL)
+    }
+    /// Follow set of state `i` (0 = initial); empty when out of range.
+    pub fn follow(&self, i: usize) -> u64 {
+        if i > self.positions() {
+            return 0;
+        }
+        rd_u64(self.rec, 36 + 2 * self.positions() + 8 * i).unwrap_or(0)
+    }
+    /// The first positions (follow set of the initial state).
+    pub fn first(&self) -> u64 {
+        self.follow(0)
+    }
+    /// Positions whose symbol is `t`.
+    pub fn symbol_mask(&self, t: Token) -> u64 {
+        let mut m = 0u64;
+        for i in 1..=self.positions() {
+            if symbol_matches(self.symbol(i), t) {
+                m |= 1 << i;
+            }
+        }
+        m
+    }
+    /// Whether the action is cyclic: its whole pattern repeats (walk, wave …), so a short
+    /// pause does not end it.
+    pub fn cyclic(&self) -> bool {
+        self.rec.get(3).is_some_and(|f| f & 1 != 0)
+    }
+    /// Forward transition: all states reachable from a state of `d` in one step.
+    #[inline]
+    pub fn forward(&self, d: u64) -> u64 {
+        let mut out = ((d << 1) & self.shift()) | (d & self.loops());
+        let mut x = d & self.extra();
+        while x != 0 {
+            let i = x.trailing_zeros() as usize;
+            out |= self.follow(i);
+            x &= x - 1;
+        }
+        out
+    }
+    /// Backward transition: all states with a successor in `d`.
+    pub fn backward(&self, d: u64) -> u64 {
+        let mut out = 0u64;
+        for i in 0..=self.positions() {
+            if self.follow(i) & d != 0 {
+                out |= 1 << i;
+            }
+        }
+        out
+    }
+}
+
+/// A validated library blob: up to [`MAX_ACTIONS`] patterns, read in place.
+#[derive(Debug, Clone, Copy)]
+pub struct Library<'a> {
+    bytes: &'a [u8],
+    n: usize,
+    offsets: [u16; MAX_ACTIONS],
+}
+
+impl<'a> Library<'a> {
+    /// An empty library (recognises nothing).
+    pub const fn empty() -> Library<'static> {
+        Library {
+            bytes: &[],
+            n: 0,
+            offsets: [0; MAX_ACTIONS],
+        }
+    }
+
+    /// Validates and wraps a library blob. Never panics; any inconsistency is an error.
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, Error> {
+        if bytes.len() > MAX_LIBRARY_BYTES {
+            return Err(Error::TooLarge);
+        }
+        let head = bytes.get(..LIBRARY_HEADER).ok_or(Error::Truncated)?;
+        if head[..3] != *b"FGL" {
+            return Err(Error::BadMagic);
+        }
+        if head[3] != LIBRARY_VERSION {
+            return Err(Error::Version(head[3]));
+        }
+        let n = usize::from(head[4]);
+        if n > MAX_ACTIONS {
+            return Err(Error::Capacity);
+        }
+        if head[5..8] != [0, 0, 0] {
+            return Err(Error::Invalid("reserved bytes"));
+        }
+        let mut offsets = [0u16; MAX_ACTIONS];
+        let mut at = LIBRARY_HEADER;
+        for slot in offsets.iter_mut().take(n) {
+            let np = usize::from(*bytes.get(at).ok_or(Error::Truncated)?);
+            if np == 0 || np > MAX_POSITIONS {
+                return Err(Error::Capacity);
+            }
+            let rec = bytes
+                .get(at..at + record_size(np))
+                .ok_or(Error::Truncated)?;
+            validate(Pattern { rec })?;
+            *slot = at as u16;
+            at += record_size(np);
+        }
+        if at != bytes.len() {
+            return Err(Error::Invalid("trailing bytes"));
+        }
+        Ok(Library { bytes, n, offsets })
+    }
+
+    /// Number of actions.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// True when the library holds no action.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// Pattern of action `i`, if present.
+    pub fn pattern(&self, i: usize) -> Option<Pattern<'a>> {
+        if i >= self.n {
+            return None;
+        }
+        let at = usize::from(*self.offsets.get(i)?);
+        let np = usize::from(*self.bytes.get(at)?);
+        let rec = self.bytes.get(at..at + record_size(np))?;
+        Some(Pattern { rec })
+    }
+}
+
+fn validate(p: Pattern<'_>) -> Result<(), Error> {
+    let n = p.positions();
+    let valid: u64 = ((1u64 << (n + 1)) - 1) & !1;
+    if p.rec.get(3).is_none_or(|f| f & !1 != 0) {
+        return Err(Error::Invalid("reserved flag bits"));
+    }
+    if p.max_edits() > MAX_EDITS {
+        return Err(Error::Capacity);
+    }
+    for i in 1..=n {
+        if !symbol_valid(p.symbol(i)) {
+            return Err(Error::Invalid("pattern symbol"));
+        }
+    }
+    let (mut shift, mut loops, mut extra) = (0u64, 0u64, 0u64);
+    for i in 0..=n {
+        let f = p.follow(i);
+        if f & !valid != 0 {
+            return Err(Error::Invalid("follow set"));
+        }
+        if i >= 1 && f & (1 << i) != 0 {
+            loops |= 1 << i;
+        }
+        if i >= 1 && i < n && f & (1 << (i + 1)) != 0 {
+            shift |= 1 << (i + 1);
+        }
+        let covered = if i == 0 { 0 } else { (1 << i) | (1 << (i + 1)) };
+        if f & !covered != 0 {
+            extra |= 1 << i;
+        }
+    }
+    if p.last() & !valid != 0 || p.last() == 0 {
+        return Err(Error::Invalid("accepting set"));
+    }
+    if (shift, loops, extra) != (p.shift(), p.loops(), p.extra()) {
+        return Err(Error::Invalid("transition masks"));
+    }
+    // Shortest accepted string by breadth-first search over state sets.
+    let mut reach = p.first();
+    let mut len = 1;
+    while reach & p.last() == 0 {
+        let next = reach | p.forward(reach);
+        if next == reach || len > n {
+            return Err(Error::Invalid("no accepting path"));
+        }
+        reach = next;
+        len += 1;
+    }
+    if len != p.min_len() || p.max_edits() >= len {
+        return Err(Error::Invalid("min_len / max_edits"));
+    }
+    Ok(())
+}
+
+/// Writes a pattern record (host side / tests): symbols of positions 1..=n and follow sets of
+/// states 0..=n. Returns the number of bytes appended, or an error if out of capacity.
+#[cfg(any(feature = "std", test))]
+pub fn encode_record(
+    out: &mut impl Extend<u8>,
+    symbols: &[Symbol],
+    follow: &[u64],
+    last: u64,
+    max_edits: u8,
+    cyclic: bool,
+) -> Result<usize, Error> {
+    let n = symbols.len();
+    if n == 0 || n > MAX_POSITIONS || follow.len() != n + 1 {
+        return Err(Error::Capacity);
+    }
+    let (mut shift, mut loops, mut extra) = (0u64, 0u64, 0u64);
+    for (i, &f) in follow.iter().enumerate() {
+        if i >= 1 && f & (1 << i) != 0 {
+            loops |= 1 << i;
+        }
+        if i >= 1 && i < n && f & (1 << (i + 1)) != 0 {
+            shift |= 1 << (i + 1);
+        }
+        let covered = if i == 0 {
+            0
+        } else {
+            (1u64 << i) | (1u64 << (i + 1))
+        };
+        if f & !covered != 0 {
+            extra |= 1 << i;
+        }
+    }
+    // Shortest accepted length, as the loader computes it.
+    let mut reach = follow[0];
+    let mut min_len = 1u8;
+    while reach & last == 0 {
+        let mut next = reach;
+        for (i, &f) in follow.iter().enumerate() {
+            if reach & (1 << i) != 0 {
+                next |= f;
+            }
+        }
+        if next == reach || usize::from(min_len) > n {
+            return Err(Error::Invalid("no accepting path"));
+        }
+        reach = next;
+        min_len += 1;
+    }
+    out.extend([n as u8, max_edits, min_len, u8::from(cyclic)]);
+    for v in [last, shift, loops, extra] {
+        out.extend(v.to_le_bytes());
+    }
+    for &s in symbols {
+        out.extend(s.to_le_bytes());
+    }
+    for &f in follow {
+        out.extend(f.to_le_bytes());
+    }
+    Ok(record_size(n))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    extern crate std;
+    use super::*;
+    use crate::token::parse_token;
+    use std::vec::Vec;
+
+    /// A library of sequential patterns `t1+ t2+ …` (each token repeatable), for tests.
+    pub fn seq_library(actions: &[(&[&str], u8)]) -> Vec<u8> {
+        let mut out = Vec::from(*b"FGL\x01");
+        out.extend([actions.len() as u8, 0, 0, 0]);
+        for (toks, k) in actions {
+            let syms: Vec<Token> = toks.iter().map(|t| parse_token(t).unwrap()).collect();
+            let n = syms.len();
+            let mut follow = std::vec![0u64; n + 1];
+            follow[0] = 1 << 1;
+            for (i, f) in follow.iter_mut().enumerate().skip(1) {
+                *f = (1 << i) | if i < n { 1 << (i + 1) } else { 0 };
+            }
+            encode_record(&mut out, &syms, &follow, 1 << n, *k, false).unwrap();
+        }
+        out
+    }
+
+    #[test]
+    fn round_trip_and_transitions() {
+        let blob = seq_library(&[(&["u", "d"], 0), (&["f", "b", "f", "b"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        assert_eq!(lib.len(), 2);
+        let p = lib.pattern(1).unwrap();
+        assert_eq!(p.positions(), 4);
+        assert_eq!(p.min_len(), 4);
+        assert_eq!(p.forward(1), 0b10);
+        assert_eq!(p.forward(0b10), 0b110);
+        assert_eq!(p.backward(0b100), 0b110);
+        assert_eq!(p.symbol_mask(parse_token("b").unwrap()), 0b10100);
+        assert!(lib.pattern(2).is_none());
+        assert!(blob.len() <= MAX_LIBRARY_BYTES);
+    }
+
+    #[test]
+    fn rejects_every_truncation_and_corruption_without_panicking() {
+        let blob = seq_library(&[(&["u", "d"], 0), (&["f", "b", "f"], 1)]);
+        for cut in 0..blob.len() {
+            assert!(Library::from_bytes(&blob[..cut]).is_err(), "cut {cut}");
+        }
+        for i in 0..blob.len() {
+            for bit in 0..8 {
+                let mut b = blob.clone();
+                b[i] ^= 1 << bit;
+                // Must not panic; many flips are detected.
+                let _ = Library::from_bytes(&b);
+            }
+        }
+        let mut b = blob.clone();
+        b[3] = 9;
+        assert_eq!(Library::from_bytes(&b).unwrap_err(), Error::Version(9));
+        let too_many_edits = seq_library(&[(&["u", "d"], 2)]);
+        assert!(Library::from_bytes(&too_many_edits).is_err());
+    }
+}

@@ -1,0 +1,406 @@
+//! The whole recognizer: samples in, [`ActionEvent`]s out.
+//!
+//! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
+//! classification (8) at commit time. No allocation, no clock: every time comes in with the
+//! samples. RAM (see `capacities` in the crate docs): front end ≈ 10.3 KiB, automata 1 KiB,
+//! effort model 0.6 KiB — about 12 KiB in all with 32 actions loaded.
+
+use crate::automaton::{earliest_start, MatcherBank, Matches};
+use crate::bayes::{quantise, EffortModel};
+use crate::features::segment_features;
+use crate::frontend::{FrontEvent, Frontend};
+use crate::history::{History, HISTORY_RUNS};
+use crate::intake::{IntakeCounters, Sample};
+use crate::pattern::{Library, MAX_ACTIONS};
+use crate::segment::{Candidate, Decider, Decision, LONG_PAUSE_US};
+use crate::token::{Token, STILL};
+
+/// A recognised action, as the device reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ActionEvent {
+    /// Action index in the loaded library.
+    pub action: u8,
+    /// Sequence number of the first sample of the segment.
+    pub start_seq: u32,
+    /// Time of that sample, µs.
+    pub start_us: u64,
+    /// Sequence number of the last sample of the segment.
+    pub end_seq: u32,
+    /// Time of that sample, µs.
+    pub end_us: u64,
+    /// Laban Time Lt quantised: value = q / 127, > 0 sudden.
+    pub time_q: i8,
+    /// Laban Weight Lw quantised: value = q / 127, > 0 strong.
+    pub weight_q: i8,
+    /// Edit distance of the match.
+    pub distance: u8,
+    /// Sequence number of the sample at which the decision was taken.
+    pub decided_seq: u32,
+    /// Time of that sample, µs (decision latency = this − `end_us`).
+    pub decided_us: u64,
+}
+
+/// Running statistics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Input validation counters.
+    pub intake: IntakeCounters,
+    /// Filtered 100 Hz ticks processed.
+    pub ticks: u32,
+    /// Non-STILL tokens fed to the automata (replays included).
+    pub tokens: u32,
+    /// Events emitted.
+    pub events: u32,
+}
+
+/// The online recognizer over a borrowed library blob (e.g. in flash).
+#[derive(Debug, Clone)]
+pub struct Recognizer<'lib> {
+    library: Library<'lib>,
+    effort: Option<EffortModel>,
+    front: Frontend,
+    bank: MatcherBank,
+    decider: Decider,
+    floor: u32,
+    tokens: u32,
+    events: u32,
+    now_us: u64,
+    now_seq: u32,
+}
+
+impl<'lib> Recognizer<'lib> {
+    /// A recognizer for `library`; without an effort model Lt = Lw = 0.
+    pub fn new(library: Library<'lib>, effort: Option<EffortModel>) -> Self {
+        Recognizer {
+            library,
+            effort,
+            front: Frontend::new(),
+            bank: MatcherBank::new(),
+            decider: Decider::new(),
+            floor: 0,
+            tokens: 0,
+            events: 0,
+            now_us: 0,
+            now_seq: 0,
+        }
+    }
+
+    /// Replaces the library (e.g. after an upload); partial matches are dropped.
+    pub fn set_library(&mut self, library: Library<'lib>) {
+        self.library = library;
+        self.restart_matching();
+    }
+
+    /// Replaces the effort model.
+    pub fn set_effort(&mut self, effort: Option<EffortModel>) {
+        self.effort = effort;
+    }
+
+    /// Statistics so far.
+    pub fn stats(&self) -> Stats {
+        Stats {
+            intake: self.front.counters(),
+            ticks: self.front.ticks(),
+            tokens: self.tokens,
+            events: self.events,
+        }
+    }
+
+    fn restart_matching(&mut self) {
+        self.bank.reset();
+        self.decider.clear();
+        self.floor = self
+            .front
+            .history()
+            .newest()
+            .map_or(0, |n| n.wrapping_add(1));
+    }
+
+    /// Feeds one sample; `emit` receives each action committed by it (in time order).
+    pub fn push(&mut self, s: &Sample, mut emit: impl FnMut(ActionEvent)) {
+        self.now_us = s.t_us;
+        self.now_seq = s.seq;
+        let mut opened: [Option<(u32, Token)>; 8] = [None; 8];
+        let mut n_opened = 0usize;
+        let mut gap = false;
+        self.front.push(s, |_, ev| match ev {
+            FrontEvent::Gap => gap = true,
+            FrontEvent::Opened { index, token } => {
+                if let Some(slot) = opened.get_mut(n_opened) {
+                    *slot = Some((index, token));
+                    n_opened += 1;
+                }
+            }
+        });
+        if gap {
+            // Runs before the gap are gone from history: commit what can be committed.
+            self.decider.clear();
+            self.bank.reset();
+            self.floor = self.front.history().oldest().unwrap_or(0);
+        }
+        for (index, token) in opened.iter().flatten().copied() {
+            if token != STILL {
+                self.feed_from(index, &mut emit);
+            }
+        }
+        // Stillness: commit after a short pause, forget partial matches after a long one.
+        let hist = self.front.history();
+        if let Some(r) = hist.newest().and_then(|i| hist.get(i)) {
+            if r.token == STILL {
+                let still = self.front.last_tick_us().saturating_sub(r.start.1);
+                if let Decision::Commit(c) = self.decider.stillness(still) {
+                    self.commit(c, &mut emit);
+                } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
+                    self.restart_matching();
+                }
+            }
+        }
+    }
+
+    /// Commits the pending candidate, if any (end of stream).
+    pub fn flush(&mut self, mut emit: impl FnMut(ActionEvent)) {
+        if let Some(c) = self.decider.pending() {
+            self.commit(c, &mut emit);
+        }
+    }
+
+    /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.
+    fn feed_from(&mut self, from: u32, emit: &mut impl FnMut(ActionEvent)) {
+        let mut i = from;
+        // Each commit moves the floor forward, so this ends within a few ring lengths.
+        for _ in 0..4 * HISTORY_RUNS {
+            let Some(newest) = self.front.history().newest() else {
+                return;
+            };
+            if i.wrapping_sub(self.floor) > newest.wrapping_sub(self.floor) {
+                return;
+            }
+            let token = match self.front.history().get(i) {
+                Some(r) => r.token,
+                None => STILL,
+            };
+            if token == STILL {
+                i = i.wrapping_add(1);
+                continue;
+            }
+            self.tokens = self.tokens.saturating_add(1);
+            let mut m: Matches = [u8::MAX; MAX_ACTIONS];
+            let best = if self.bank.step(&self.library, token, &mut m) {
+                self.best_candidate(i, &m)
+            } else {
+                None
+            };
+            match self.decider.offer(best, self.floor) {
+                Decision::Wait => i = i.wrapping_add(1),
+                Decision::Commit(c) => {
+                    self.commit(c, emit);
+                    i = self.floor;
+                }
+            }
+        }
+    }
+
+    fn best_candidate(&self, end: u32, m: &Matches) -> Option<Candidate> {
+        // The non-STILL runs from `end` back to the floor, newest first.
+        let hist: &History = self.front.history();
+        let mut idx = [0u32; HISTORY_RUNS];
+        let mut tok = [STILL; HISTORY_RUNS];
+        let mut n = 0usize;
+        let mut i = end;
+        for _ in 0..HISTORY_RUNS {
+            if i.wrapping_sub(self.floor) > end.wrapping_sub(self.floor) {
+                break;
+            }
+            let Some(r) = hist.get(i) else { break };
+            if r.token != STILL {
+                if let (Some(x), Some(t)) = (idx.get_mut(n), tok.get_mut(n)) {
+                    *x = i;
+                    *t = r.token;
+                    n += 1;
+                }
+            }
+            i = i.wrapping_sub(1);
+        }
+        let mut best: Option<Candidate> = None;
+        for (a, &d) in m.iter().enumerate() {
+            if d == u8::MAX {
+                continue;
+            }
+            let Some(p) = self.library.pattern(a) else {
+                continue;
+            };
+            let found = earliest_start(&p, d, |j| if j < n { tok.get(j).copied() } else { None });
+            let Some((j, k)) = found else { continue };
+            let c = Candidate {
+                action: a as u8,
+                start: idx.get(j).copied().unwrap_or(end),
+                end,
+                distance: k,
+                len: (j + 1) as u16,
+                min_len: p.min_len().min(255) as u8,
+                cyclic: p.cyclic(),
+            };
+            if best.is_none_or(|b| c.beats(&b)) {
+                best = Some(c);
+            }
+        }
+        best
+    }
+
+    fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+        let hist = self.front.history();
+        let start = hist.get(c.start).map(|r| r.start);
+        let end = hist.get(c.end).map(|r| r.end);
+        if let (Some(start), Some(end)) = (start, end) {
+            let (lt, lw) = match &self.effort {
+                Some(m) => m.classify(&segment_features(&hist.accum(c.start, c.end))),
+                None => (0.0, 0.0),
+            };
+            emit(ActionEvent {
+                action: c.action,
+                start_seq: start.0,
+                start_us: start.1,
+                end_seq: end.0,
+                end_us: end.1,
+                time_q: quantise(lt),
+                weight_q: quantise(lw),
+                distance: c.distance,
+                decided_seq: self.now_seq,
+                decided_us: self.now_us,
+            });
+            self.events = self.events.saturating_add(1);
+        }
+        self.bank.reset();
+        self.decider.clear();
+        self.floor = c.end.wrapping_add(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::pattern::tests::seq_library;
+    use proptest::prelude::*;
+    use std::vec::Vec;
+
+    /// A figurine hopping forward `hops` times (up-forward, down-forward), 120 Hz, then still.
+    fn hops(hops: usize, t0_us: u64) -> Vec<Sample> {
+        let mut out = Vec::new();
+        let rate = 120.0f32;
+        let still = 0.6f32;
+        let hop = 0.5f32;
+        let total = 2.0 * still + hops as f32 * hop;
+        let n = (total * rate) as u32;
+        for i in 0..n {
+            let t = i as f32 / rate;
+            let (mut y, mut z) = (0.0f32, 0.0f32);
+            if t > still {
+                let h = ((t - still) / hop).min(hops as f32);
+                let phase = h - libm::floorf(h);
+                z = 0.2 * h;
+                if h < hops as f32 {
+                    y = 0.1 * libm::sinf(core::f32::consts::PI * phase);
+                }
+            }
+            out.push(Sample {
+                seq: i,
+                t_us: t0_us + (t * 1e6) as u64,
+                pos: [0.3, 1.0 + y, z],
+                quat: [1.0, 0.0, 0.0, 0.0],
+            });
+        }
+        out
+    }
+
+    fn run(lib: &Library<'_>, samples: &[Sample]) -> Vec<ActionEvent> {
+        let mut rec = Recognizer::new(*lib, None);
+        let mut ev = Vec::new();
+        for s in samples {
+            rec.push(s, |e| ev.push(e));
+        }
+        rec.flush(|e| ev.push(e));
+        ev
+    }
+
+    #[test]
+    fn a_hop_sequence_is_recognised_with_its_segment() {
+        let blob = seq_library(&[(&["uf", "f", "df"], 0), (&["l", "r"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &hops(1, 5_000_000));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        let e = ev[0];
+        assert_eq!(e.action, 0);
+        // The segment lies within the hop (0.6 s … 1.1 s after the start, ± filter edges).
+        let (s, t) = (e.start_us - 5_000_000, e.end_us - 5_000_000);
+        assert!((550_000..750_000).contains(&s), "start {s}");
+        assert!((950_000..1_200_000).contains(&t), "end {t}");
+        assert!(e.decided_us > e.end_us && e.decided_us - e.end_us < 400_000);
+    }
+
+    #[test]
+    fn the_longest_action_wins() {
+        // "hop" is one hop; "double" two hops: two hops in a row are one `double`.
+        let blob = seq_library(&[
+            (&["uf", "f", "df"], 0),
+            (&["uf", "f", "df", "uf", "f", "df"], 1),
+        ]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &hops(2, 0));
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [1],
+            "{ev:?}"
+        );
+    }
+
+    fn any_sample() -> impl Strategy<Value = Sample> {
+        let f = prop_oneof![
+            8 => -3.0f32..3.0,
+            1 => Just(f32::NAN),
+            1 => Just(f32::INFINITY),
+            1 => Just(0.0f32),
+            1 => any::<f32>(),
+        ];
+        (
+            any::<u32>(),
+            0u64..3_000_000,
+            [f.clone(), f.clone(), f.clone()],
+            [f.clone(), f.clone(), f.clone(), f],
+        )
+            .prop_map(|(seq, t_us, pos, quat)| Sample {
+                seq,
+                t_us,
+                pos,
+                quat,
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn arbitrary_streams_never_panic_and_every_sample_is_counted(
+            mut stream in proptest::collection::vec(any_sample(), 0..400),
+            sorted in any::<bool>(),
+        ) {
+            if sorted {
+                stream.sort_by_key(|s| s.t_us);
+            }
+            let blob = seq_library(&[(&["uf", "df"], 0), (&["u", "d", "u"], 1), (&["f.Yp"], 0)]);
+            let lib = Library::from_bytes(&blob).unwrap();
+            let mut rec = Recognizer::new(lib, None);
+            let mut events = 0u32;
+            for s in &stream {
+                rec.push(s, |e| {
+                    assert!(e.end_us >= e.start_us);
+                    events += 1;
+                });
+            }
+            rec.flush(|_| events += 1);
+            let st = rec.stats();
+            prop_assert_eq!((st.intake.accepted + st.intake.skipped()) as usize, stream.len());
+            prop_assert_eq!(st.events, events);
+        }
+    }
+}

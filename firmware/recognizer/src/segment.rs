@@ -1,0 +1,178 @@
+//! Stage 6 — online segment decision: when to commit which action.
+//!
+//! Each token that completes one or more approximate matches yields candidates (action, first
+//! and last run, distance, length in tokens). A pending candidate is replaced by an overlapping
+//! one of higher merit `2·length − 3·distance` — near-ties go to the longest action, as in
+//! seed 000 §7.5, and an action that keeps extending (a walk of several hops) grows instead of
+//! being cut. The pending candidate is committed when
+//! - a candidate appears that starts after it (the next action has begun),
+//! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
+//! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
+//!   whose pattern repeats as a whole), or
+//! - the stream ends ([`crate::Recognizer::flush`]).
+//!
+//! After a commit, matching restarts just after the committed segment (the tokens seen during
+//! the look-ahead are replayed), so segments never overlap.
+
+/// Non-STILL tokens to wait after a candidate's end for a longer/better one.
+pub const LOOKAHEAD_TOKENS: u8 = 4;
+/// Stillness after a candidate that commits it, µs.
+pub const PAUSE_US: u64 = 120_000;
+/// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
+/// pauses briefly between hops without ending.
+pub const CYCLIC_PAUSE_US: u64 = 300_000;
+/// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
+pub const LONG_PAUSE_US: u64 = 2_500_000;
+
+/// A possible action segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidate {
+    /// Action index in the library.
+    pub action: u8,
+    /// First run (absolute history index).
+    pub start: u32,
+    /// Last run (absolute history index).
+    pub end: u32,
+    /// Edit distance.
+    pub distance: u8,
+    /// Non-STILL tokens covered.
+    pub len: u16,
+    /// Shortest match of the action's pattern (its specificity), tokens.
+    pub min_len: u8,
+    /// The pattern can repeat as a whole (a cyclic action: walk, wave …).
+    pub cyclic: bool,
+}
+
+impl Candidate {
+    /// Ranking score: longer is better, each edit costs 1.5 tokens.
+    pub fn merit(&self) -> i32 {
+        2 * i32::from(self.len) - 3 * i32::from(self.distance)
+    }
+
+    /// True when `self` should replace `other`: higher merit; at equal merit the more
+    /// specific pattern (longer shortest match), then fewer edits, then the lower index.
+    pub fn beats(&self, other: &Candidate) -> bool {
+        (self.merit(), self.min_len, other.distance, other.action)
+            > (other.merit(), other.min_len, self.distance, self.action)
+    }
+}
+
+/// What the decider wants done after an offer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Decision {
+    /// Nothing to commit yet.
+    Wait,
+    /// Commit this candidate and restart matching after its end.
+    Commit(Candidate),
+}
+
+/// The pending-candidate state machine.
+#[derive(Debug, Clone, Default)]
+pub struct Decider {
+    pending: Option<Candidate>,
+    since_end: u8,
+}
+
+impl Decider {
+    /// No pending candidate.
+    pub const fn new() -> Self {
+        Decider {
+            pending: None,
+            since_end: 0,
+        }
+    }
+
+    /// The pending candidate.
+    pub fn pending(&self) -> Option<Candidate> {
+        self.pending
+    }
+
+    /// Drops the pending candidate (after a commit or a restart).
+    pub fn clear(&mut self) {
+        self.pending = None;
+        self.since_end = 0;
+    }
+
+    /// A non-STILL token was fed; `best` is the best candidate ending at it, if any.
+    /// Run indices are compared relative to `floor` (the first run matching may use).
+    pub fn offer(&mut self, best: Option<Candidate>, floor: u32) -> Decision {
+        let rel = |i: u32| i.wrapping_sub(floor);
+        match (self.pending, best) {
+            (None, Some(c)) => {
+                self.pending = Some(c);
+                self.since_end = 0;
+                Decision::Wait
+            }
+            (None, None) => Decision::Wait,
+            (Some(p), Some(c)) if rel(c.start) > rel(p.end) => Decision::Commit(p),
+            (Some(p), Some(c)) if c.beats(&p) => {
+                self.pending = Some(c);
+                self.since_end = 0;
+                Decision::Wait
+            }
+            (Some(p), _) => {
+                self.since_end = self.since_end.saturating_add(1);
+                if self.since_end >= LOOKAHEAD_TOKENS {
+                    Decision::Commit(p)
+                } else {
+                    Decision::Wait
+                }
+            }
+        }
+    }
+
+    /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`].
+    pub fn stillness(&mut self, still_us: u64) -> Decision {
+        match self.pending {
+            Some(p) if still_us >= if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US } => {
+                Decision::Commit(p)
+            }
+            _ => Decision::Wait,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(action: u8, start: u32, end: u32, distance: u8) -> Candidate {
+        Candidate {
+            action,
+            start,
+            end,
+            distance,
+            len: (end - start + 1) as u16,
+            min_len: 1,
+            cyclic: false,
+        }
+    }
+
+    #[test]
+    fn longest_wins_near_ties_and_lookahead_commits() {
+        let mut d = Decider::new();
+        assert_eq!(d.offer(Some(c(0, 2, 3, 0)), 0), Decision::Wait);
+        // A longer overlapping match with one edit still wins (merit 9 vs 4).
+        assert_eq!(d.offer(Some(c(1, 1, 5, 1)), 0), Decision::Wait);
+        assert_eq!(d.pending().unwrap().action, 1);
+        // A shorter overlapping exact match does not.
+        assert_eq!(d.offer(Some(c(2, 4, 5, 0)), 0), Decision::Wait);
+        assert_eq!(d.offer(None, 0), Decision::Wait);
+        assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
+    }
+
+    #[test]
+    fn a_later_candidate_or_a_pause_commits() {
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 2, 3, 0)), 0);
+        assert_eq!(
+            d.offer(Some(c(1, 4, 6, 0)), 0),
+            Decision::Commit(c(0, 2, 3, 0))
+        );
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 2, 3, 0)), 0);
+        assert_eq!(d.stillness(PAUSE_US - 1), Decision::Wait);
+        assert_eq!(d.stillness(PAUSE_US), Decision::Commit(c(0, 2, 3, 0)));
+        assert_eq!(Decider::new().stillness(10 * PAUSE_US), Decision::Wait);
+    }
+}

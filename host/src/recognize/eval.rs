@@ -1,0 +1,380 @@
+//! `figurine eval`: recognition and effort accuracy on synthetic doodles, like seed 000
+//! Fig. 7–9.
+//!
+//! By default everything is fresh: each of the 12 actions is learnt from `--examples` (3)
+//! generated performances (seed `--train-seed`), the effort model is trained on a generated
+//! effort set (same seed), and the test set comes from `--seed` (different). `--library` /
+//! `--effort` evaluate given files instead. Reported:
+//! - isolated gestures: per action, the share whose main event (the one overlapping the
+//!   performance most) is the right action, and the confusions;
+//! - Time, Weight and state accuracy of the correctly recognised isolated gestures;
+//! - sequences: events matched to labels (same action, overlapping in time, one-to-one),
+//!   precision, recall and F1;
+//! - decision latency: when the event was emitted, after the performance's labelled end
+//!   (median and 90th percentile).
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+
+use super::effort_model::EffortFile;
+use super::effort_train::{gesture_features, train, Example, Trained};
+use super::feed::{log_samples, recognize_log, Clock};
+use super::learn::learn_action;
+use super::library::LibraryFile;
+use super::simulate::load_effort;
+use crate::synth::{self, Action, Doodle, Knobs, Label, TimeClass, WeightClass};
+use figurine_recognizer::{EffortModel, Library, Recognizer};
+
+/// Arguments of `figurine eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// Seed of the test set (use one nothing was trained on).
+    #[arg(long, default_value_t = 1000)]
+    pub seed: u64,
+    /// Seed of the learning examples and effort training set.
+    #[arg(long, default_value_t = 1)]
+    pub train_seed: u64,
+    /// Learning examples per action.
+    #[arg(long, default_value_t = 3)]
+    pub examples: usize,
+    /// Effort training gestures per state.
+    #[arg(long, default_value_t = 40)]
+    pub effort_per_class: usize,
+    /// Isolated test gestures per action.
+    #[arg(long, default_value_t = 20)]
+    pub isolated: usize,
+    /// Test sequences.
+    #[arg(long, default_value_t = 20)]
+    pub sequences: usize,
+    /// Actions per sequence.
+    #[arg(long, default_value_t = 6)]
+    pub sequence_len: usize,
+    /// Evaluate this library instead of learning one.
+    #[arg(long)]
+    pub library: Option<PathBuf>,
+    /// Evaluate this effort model instead of training one.
+    #[arg(long)]
+    pub effort: Option<PathBuf>,
+    /// Save the learnt library here.
+    #[arg(long)]
+    pub save_library: Option<PathBuf>,
+    /// Save the trained effort model here.
+    #[arg(long)]
+    pub save_effort: Option<PathBuf>,
+    /// Print the token string of every misrecognised isolated gesture.
+    #[arg(long)]
+    pub verbose: bool,
+}
+
+/// Learns every synth action from `n` generated examples.
+pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<LibraryFile> {
+    let mut lib = LibraryFile::default();
+    for (i, &action) in Action::ALL.iter().enumerate() {
+        let docs = synth::examples(
+            synth::sequence::item_seed(seed, 100 + i as u64),
+            knobs,
+            action,
+            n,
+            None,
+        );
+        let logs: Vec<_> = docs.into_iter().map(|d| d.log).collect();
+        lib.upsert(learn_action(action.name(), &logs, None, true)?);
+    }
+    Ok(lib)
+}
+
+/// Trains the effort model on a generated effort set.
+pub fn train_synth_effort(
+    seed: u64,
+    per_class: usize,
+    knobs: &Knobs,
+) -> Result<(Vec<Example>, Trained)> {
+    let set = synth::effort_set(seed, knobs, per_class);
+    let ex: Vec<Example> = set
+        .iter()
+        .filter_map(|(e, d)| {
+            gesture_features(&d.log).map(|f| Example {
+                f,
+                sudden: e.time == TimeClass::Sudden,
+                strong: e.weight == WeightClass::Strong,
+            })
+        })
+        .collect();
+    let t = train(&ex)?;
+    Ok((ex, t))
+}
+
+/// One recognised event in log seconds.
+#[derive(Debug, Clone)]
+pub struct Ev {
+    /// Action name.
+    pub action: String,
+    /// Start, s.
+    pub start: f64,
+    /// End, s.
+    pub end: f64,
+    /// Decision time, s.
+    pub decided: f64,
+    /// Lt.
+    pub time: f64,
+    /// Lw.
+    pub weight: f64,
+}
+
+/// Runs the recognizer over a doodle.
+pub fn run_doodle(
+    d: &Doodle,
+    names: &[String],
+    blob: &[u8],
+    effort: EffortModel,
+) -> Result<Vec<Ev>> {
+    let lib = Library::from_bytes(blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut rec = Recognizer::new(lib, Some(effort));
+    let (samples, _) = log_samples(&d.log);
+    let clock = Clock::new(&d.log, &samples);
+    Ok(recognize_log(&mut rec, &samples)
+        .iter()
+        .map(|e| Ev {
+            action: names
+                .get(usize::from(e.action))
+                .cloned()
+                .unwrap_or_default(),
+            start: clock.time_of(e.start_seq),
+            end: clock.time_of(e.end_seq),
+            decided: clock.time_of(e.decided_seq),
+            time: f64::from(e.time_q) / 127.0,
+            weight: f64::from(e.weight_q) / 127.0,
+        })
+        .collect())
+}
+
+fn overlap(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
+    (a1.min(b1) - a0.max(b0)).max(0.0)
+}
+
+/// Evaluation figures.
+#[derive(Debug, Clone, Default)]
+pub struct Figures {
+    /// Per action: (correct, total) on isolated gestures.
+    pub per_action: Vec<(String, usize, usize)>,
+    /// Isolated accuracy.
+    pub isolated: f64,
+    /// Time / Weight / state accuracy over correctly recognised isolated gestures.
+    pub time: f64,
+    /// Weight accuracy.
+    pub weight: f64,
+    /// State accuracy.
+    pub state: f64,
+    /// Sequence precision, recall, F1.
+    pub seq_prf: (f64, f64, f64),
+    /// Decision latencies (s) of matched events.
+    pub latencies: Vec<f64>,
+    /// Confusions: (truth, recognised-as or "none", count).
+    pub confusions: Vec<(String, String, usize)>,
+}
+
+fn label_ok(l: &Label, ev: &Ev) -> (bool, bool) {
+    (
+        (ev.time > 0.0) == (l.time_class == TimeClass::Sudden),
+        (ev.weight > 0.0) == (l.weight_class == WeightClass::Strong),
+    )
+}
+
+/// Evaluates a library and effort model on a fresh synthetic test set.
+pub fn evaluate(
+    args: &EvalArgs,
+    lib: &mut LibraryFile,
+    effort: EffortModel,
+    knobs: &Knobs,
+) -> Result<Figures> {
+    let names = lib.names();
+    let blob = lib.blob()?;
+    let mut f = Figures::default();
+    let (mut eff_n, mut t_ok, mut w_ok, mut s_ok) = (0usize, 0usize, 0usize, 0usize);
+    let mut conf = std::collections::BTreeMap::<(String, String), usize>::new();
+    for (ai, &action) in Action::ALL.iter().enumerate() {
+        let mut ok = 0;
+        for k in 0..args.isolated {
+            let seed = synth::sequence::item_seed(args.seed, (ai * 10_000 + k) as u64);
+            let d = synth::examples(seed, knobs, action, 1, None).remove(0);
+            let l = &d.labels[0];
+            let evs = run_doodle(&d, &names, &blob, effort)?;
+            let main = evs
+                .iter()
+                .max_by(|a, b| {
+                    overlap(a.start, a.end, l.start, l.end)
+                        .total_cmp(&overlap(b.start, b.end, l.start, l.end))
+                })
+                .filter(|e| overlap(e.start, e.end, l.start, l.end) > 0.0);
+            let got = main.map_or("none".to_string(), |e| e.action.clone());
+            if got == l.action {
+                ok += 1;
+                let (t, w) = label_ok(l, main.unwrap_or(&evs[0]));
+                eff_n += 1;
+                t_ok += usize::from(t);
+                w_ok += usize::from(w);
+                s_ok += usize::from(t && w);
+                f.latencies.push(main.map_or(0.0, |e| e.decided - l.end));
+            } else {
+                if args.verbose {
+                    let t = super::learn::tokenize_gesture(&d.log);
+                    eprintln!(
+                        "{} -> {got}: {}",
+                        l.action,
+                        super::library::tokens_to_string(&super::learn::tokens_only(&t))
+                    );
+                }
+                *conf.entry((l.action.clone(), got)).or_default() += 1;
+            }
+        }
+        f.per_action
+            .push((action.name().to_string(), ok, args.isolated));
+    }
+    let (ok, n): (usize, usize) = f
+        .per_action
+        .iter()
+        .fold((0, 0), |a, x| (a.0 + x.1, a.1 + x.2));
+    f.isolated = ok as f64 / n.max(1) as f64;
+    f.time = t_ok as f64 / eff_n.max(1) as f64;
+    f.weight = w_ok as f64 / eff_n.max(1) as f64;
+    f.state = s_ok as f64 / eff_n.max(1) as f64;
+    f.confusions = conf.into_iter().map(|((a, b), c)| (a, b, c)).collect();
+    // Sequences.
+    let (mut matched, mut n_ev, mut n_lab) = (0usize, 0usize, 0usize);
+    for k in 0..args.sequences {
+        let seed = synth::sequence::item_seed(args.seed ^ 0x5e9_5e9, k as u64);
+        let d = synth::sequence(seed, knobs, args.sequence_len, None);
+        let evs = run_doodle(&d, &names, &blob, effort)?;
+        n_ev += evs.len();
+        n_lab += d.labels.len();
+        if args.verbose && k < 3 {
+            for l in &d.labels {
+                eprintln!("  label {:<9} {:7.2} {:7.2}", l.action, l.start, l.end);
+            }
+            for e in &evs {
+                eprintln!("  event {:<9} {:7.2} {:7.2}", e.action, e.start, e.end);
+            }
+        }
+        let mut used = vec![false; evs.len()];
+        for l in &d.labels {
+            let best = evs
+                .iter()
+                .enumerate()
+                .filter(|(i, e)| {
+                    !used[*i]
+                        && e.action == l.action
+                        && overlap(e.start, e.end, l.start, l.end) > 0.0
+                })
+                .max_by(|a, b| {
+                    overlap(a.1.start, a.1.end, l.start, l.end)
+                        .total_cmp(&overlap(b.1.start, b.1.end, l.start, l.end))
+                });
+            if let Some((i, e)) = best {
+                used[i] = true;
+                matched += 1;
+                f.latencies.push(e.decided - l.end);
+            }
+        }
+    }
+    let p = matched as f64 / n_ev.max(1) as f64;
+    let r = matched as f64 / n_lab.max(1) as f64;
+    f.seq_prf = (
+        p,
+        r,
+        if p + r > 0.0 {
+            2.0 * p * r / (p + r)
+        } else {
+            0.0
+        },
+    );
+    Ok(f)
+}
+
+/// Median and 90th percentile.
+pub fn quantiles(v: &[f64]) -> (f64, f64) {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    (s[s.len() / 2], s[(s.len() * 9 / 10).min(s.len() - 1)])
+}
+
+/// `figurine eval`.
+pub fn run(args: &EvalArgs) -> Result<()> {
+    let knobs = Knobs::default();
+    let mut lib = match &args.library {
+        Some(p) => LibraryFile::read(p)?,
+        None => {
+            eprintln!(
+                "learning {} actions from {} examples each (seed {})…",
+                Action::ALL.len(),
+                args.examples,
+                args.train_seed
+            );
+            learn_synth_library(args.train_seed, args.examples, &knobs)?
+        }
+    };
+    if let Some(p) = &args.save_library {
+        lib.write(p)?;
+    }
+    let effort = match &args.effort {
+        Some(p) => load_effort(Some(p))?,
+        None => {
+            eprintln!(
+                "training effort on {} gestures per state (seed {})…",
+                args.effort_per_class, args.train_seed
+            );
+            let (_, t) = train_synth_effort(args.train_seed, args.effort_per_class, &knobs)?;
+            if let Some(p) = &args.save_effort {
+                t.file.write(p)?;
+            }
+            t.file.model()?
+        }
+    };
+    let _ = EffortFile::default_model;
+    let f = evaluate(args, &mut lib, effort, &knobs)?;
+    println!(
+        "Isolated gestures (seed {}), {} per action:",
+        args.seed, args.isolated
+    );
+    println!("{:<10} {:>8}", "action", "correct");
+    for (a, ok, n) in &f.per_action {
+        println!(
+            "{:<10} {:>7.1}%",
+            a,
+            100.0 * *ok as f64 / (*n).max(1) as f64
+        );
+    }
+    println!("{:<10} {:>7.1}%", "ALL", 100.0 * f.isolated);
+    if !f.confusions.is_empty() {
+        println!("confusions (truth -> recognised: count):");
+        for (a, b, c) in &f.confusions {
+            println!("  {a} -> {b}: {c}");
+        }
+    }
+    println!("Laban effort on recognised isolated gestures:");
+    println!(
+        "  Time {:.1}%   Weight {:.1}%   state {:.1}%",
+        100.0 * f.time,
+        100.0 * f.weight,
+        100.0 * f.state
+    );
+    println!(
+        "Sequences ({} × {} actions): precision {:.1}%  recall {:.1}%  F1 {:.1}%",
+        args.sequences,
+        args.sequence_len,
+        100.0 * f.seq_prf.0,
+        100.0 * f.seq_prf.1,
+        100.0 * f.seq_prf.2
+    );
+    let (med, p90) = quantiles(&f.latencies);
+    println!(
+        "Decision latency after the gesture ends: median {:.0} ms, 90th percentile {:.0} ms",
+        1000.0 * med,
+        1000.0 * p90
+    );
+    Ok(())
+}

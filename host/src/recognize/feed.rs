@@ -1,0 +1,131 @@
+//! Pose logs into the recognizer, through the wire quantisation.
+//!
+//! Host simulation must see exactly the numbers the MCU sees, so every log sample goes through
+//! [`wire_sample`]: quantised into a `figurine_protocol::Pose` (0.1 mm, smallest-three
+//! quaternion, u32 µs, u16 seq) and decoded back with the same routines the firmware uses
+//! (including the wrap-extending time and sequence unwrappers). Samples the wire cannot carry
+//! (NaN, beyond ±100 m, zero quaternion) are dropped here and counted, as the link would.
+
+use figurine_protocol::pose::{Pose, SeqUnwrapper, TimeUnwrapper};
+use figurine_recognizer::frontend::{FrontEvent, Frontend};
+use figurine_recognizer::history::Run;
+use figurine_recognizer::token::STILL;
+use figurine_recognizer::{ActionEvent, Recognizer, Sample};
+
+use crate::poselog::PoseLog;
+
+/// Turns log samples into device samples, as the link would deliver them.
+#[derive(Debug, Default, Clone)]
+pub struct WireFeed {
+    time: TimeUnwrapper,
+    seq: SeqUnwrapper,
+    /// Log samples the wire could not carry.
+    pub unsendable: u64,
+}
+
+impl WireFeed {
+    /// Quantises log sample `index` (its seq is `index` mod 2¹⁶ on the wire) and decodes it as
+    /// the firmware does. `None` if the wire cannot carry it.
+    pub fn wire_sample(
+        &mut self,
+        index: usize,
+        t_s: f64,
+        pos: [f64; 3],
+        quat: [f64; 4],
+    ) -> Option<Sample> {
+        match Pose::quantize(index as u16, t_s, pos, quat) {
+            Ok(p) => Some(Sample {
+                seq: self.seq.unwrap(p.seq),
+                t_us: self.time.unwrap(p.t_us),
+                pos: p.position_m(),
+                quat: p.orientation(),
+            }),
+            Err(_) => {
+                self.unsendable += 1;
+                None
+            }
+        }
+    }
+}
+
+/// The device samples of a whole log, with the index of the log sample each came from.
+pub fn log_samples(log: &PoseLog) -> (Vec<(usize, Sample)>, u64) {
+    let mut feed = WireFeed::default();
+    let out = log
+        .samples
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| feed.wire_sample(i, s.t, s.pos, s.quat).map(|x| (i, x)))
+        .collect();
+    (out, feed.unsendable)
+}
+
+/// Maps device sequence numbers back to log times (seconds on the log's clock).
+#[derive(Debug, Clone)]
+pub struct Clock {
+    first_seq: u32,
+    times: Vec<f64>,
+}
+
+impl Clock {
+    /// The clock of a log whose samples were fed with [`log_samples`].
+    pub fn new(log: &PoseLog, samples: &[(usize, Sample)]) -> Self {
+        let first_seq = samples.first().map_or(0, |(_, s)| s.seq);
+        let first_idx = samples.first().map_or(0, |(i, _)| *i);
+        Clock {
+            first_seq: first_seq.wrapping_sub(first_idx as u32),
+            times: log.samples.iter().map(|s| s.t).collect(),
+        }
+    }
+
+    /// Log time of the sample with device sequence number `seq`.
+    pub fn time_of(&self, seq: u32) -> f64 {
+        let i = seq.wrapping_sub(self.first_seq) as usize;
+        self.times.get(i).copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// Runs the recognizer over a whole log; returns the events in time order.
+pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> Vec<ActionEvent> {
+    let mut events = Vec::new();
+    for (_, s) in samples {
+        rec.push(s, |e| events.push(e));
+    }
+    rec.flush(|e| events.push(e));
+    events
+}
+
+/// All token runs of a log (STILL included), in order, with their feature sums.
+pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
+    let mut front = Frontend::new();
+    let mut runs = Vec::new();
+    for (_, s) in samples {
+        front.push(s, |f, ev| {
+            if let FrontEvent::Opened { index, .. } = ev {
+                if let Some(prev) = f.history().get(index.wrapping_sub(1)) {
+                    runs.push(*prev);
+                }
+            }
+        });
+    }
+    if let Some(last) = front
+        .history()
+        .newest()
+        .and_then(|i| front.history().get(i))
+    {
+        runs.push(*last);
+    }
+    // A gap clears the history, so consecutive duplicates cannot arise; keep order as seen.
+    runs
+}
+
+/// The runs of a one-gesture log between its first and last motion (leading and trailing
+/// STILL removed).
+pub fn gesture_runs(runs: &[Run]) -> &[Run] {
+    let first = runs.iter().position(|r| r.token != STILL);
+    let last = runs.iter().rposition(|r| r.token != STILL);
+    match (first, last) {
+        (Some(a), Some(b)) => &runs[a..=b],
+        _ => &[],
+    }
+}

@@ -1,0 +1,683 @@
+//! `figurine learn`: an action's pattern from a few example logs (seed 000 §4.3).
+//!
+//! 1. Each example is tokenized by the device front end (through the wire quantisation); its
+//!    gesture is the span from the first to the last non-STILL run.
+//! 2. The examples are DTW-averaged ([`super::dtw`]) and the average doodle is tokenized too.
+//! 3. In every token string, a run is *mandatory* when it lasts at least
+//!    [`MANDATORY_SHARE`] of that gesture's moving time (a deliberate part of the gesture),
+//!    otherwise *optional* (a transition or a wobble). The seed's "repeated more than twice"
+//!    counts samples; durations make the rule independent of the sample rate.
+//! 4. The mandatory strings of the examples are aligned to the average's by edit-distance
+//!    alignment. Column i becomes `(m_i0|…|m_in)+`, or `…*` when some example lacks it.
+//! 5. The optional tokens found between two columns become `(o_1|…|o_k)*` before the later
+//!    column — or mandatory columns when every example has the same optional sequence there.
+//! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
+//!    three tokens of the shortest match.
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use figurine_recognizer::automaton::{earliest_start, MatcherBank};
+use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
+use figurine_recognizer::token::{
+    mirror_token, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
+};
+use figurine_recognizer::Library;
+
+use super::dtw;
+use super::feed::{gesture_runs, log_runs, log_samples};
+use super::library::{parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
+use super::regex::{default_edits, Regex};
+use crate::poselog::PoseLog;
+
+/// Share of a gesture's moving time a run needs to be mandatory.
+pub const MANDATORY_SHARE: f64 = 0.08;
+
+/// Arguments of `figurine learn`.
+#[derive(Args, Debug)]
+pub struct LearnArgs {
+    /// The library file to update (created if missing).
+    #[arg(long)]
+    pub library: PathBuf,
+    /// Name of the action to learn or replace.
+    #[arg(long)]
+    pub name: String,
+    /// Edit bound (default: one per three tokens of the shortest match, at most 3).
+    #[arg(long)]
+    pub max_edits: Option<u8>,
+    /// Do not also accept the mirror image (left ↔ right) of the examples.
+    #[arg(long)]
+    pub no_mirror: bool,
+    /// Example logs, one performance each (three are usually enough).
+    #[arg(required = true)]
+    pub examples: Vec<PathBuf>,
+}
+
+/// One tokenized gesture: (token, duration in seconds) per run, STILL removed.
+pub type Tokenized = Vec<(Token, f64)>;
+
+/// Tokenizes the gesture of a one-performance log.
+pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    gesture_runs(&runs)
+        .iter()
+        .filter(|r| r.token != STILL)
+        .map(|r| {
+            (
+                r.token,
+                (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01,
+            )
+        })
+        .collect()
+}
+
+/// The span (seconds, log clock) from the first to the last motion of a one-gesture log.
+fn motion_span(log: &PoseLog) -> Option<(f64, f64)> {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g = gesture_runs(&runs);
+    let (first, last) = (g.first()?, g.last()?);
+    let clock = super::feed::Clock::new(log, &samples);
+    Some((clock.time_of(first.start.0), clock.time_of(last.end.0)))
+}
+
+/// Rotation (rad) below which a run's rotation half is a wobble, not part of the gesture.
+pub const INCIDENTAL_ANGLE_RAD: f64 = 0.35;
+/// Share of the gesture's path length below which a run's translation half is incidental.
+pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
+
+/// Like [`tokenize_gesture`], but each run is written as the symbol of what it means: a half
+/// that barely moved (a rotation of less than [`INCIDENTAL_ANGLE_RAD`], a translation shorter
+/// than [`INCIDENTAL_PATH_SHARE`] of the path) becomes a wildcard, so `d.Xp` with a 5° tilt is
+/// learnt as `d~`.
+pub fn intent_symbols(log: &PoseLog) -> Tokenized {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g: Vec<_> = gesture_runs(&runs)
+        .iter()
+        .filter(|r| r.token != STILL)
+        .copied()
+        .collect();
+    let dt = f64::from(figurine_recognizer::intake::TICK_S);
+    let path: f64 = g.iter().map(|r| f64::from(r.acc.sum[18]) * dt).sum();
+    g.iter()
+        .map(|r| {
+            let t = r.token;
+            let (lin, ang) = (t / 27, t % 27);
+            let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
+            let dist = dt * f64::from(r.acc.sum[18]);
+            let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
+                lin * 27 + NONE_BIN | ANY_ROT
+            } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
+                NONE_BIN * 27 + ang | ANY_LIN
+            } else {
+                t
+            };
+            (
+                sym,
+                (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01,
+            )
+        })
+        .collect()
+}
+
+/// Token string as the automata see it (STILL already removed).
+pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
+    t.iter().map(|x| x.0).collect()
+}
+
+fn mandatory_flags(t: &Tokenized) -> Vec<bool> {
+    let total: f64 = t.iter().map(|x| x.1).sum();
+    // The half-turn marker is always deliberate, however short its run.
+    t.iter()
+        .map(|x| x.0 == TURN || x.1 >= MANDATORY_SHARE * total)
+        .collect()
+}
+
+/// Mandatory runs (token, index in `t`); a repeat of the previous mandatory token separated
+/// from it only by optional runs is the same gesture part and is merged.
+fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
+    let flags = mandatory_flags(t);
+    let mut mand: Vec<(Token, usize)> = Vec::new();
+    for (i, (x, f)) in t.iter().zip(&flags).enumerate() {
+        if !*f {
+            continue;
+        }
+        match mand.last() {
+            Some(&(prev, at)) if prev == x.0 && at + 1 < i => {}
+            _ => mand.push((x.0, i)),
+        }
+    }
+    mand
+}
+
+/// Replaces tokens that differ only in one half by a wildcard symbol (`uf~`, `~.Yp`) when at
+/// least two of them share the other half: the examples disagree there, so it is not part of
+/// the gesture.
+pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
+    let mut out = BTreeSet::new();
+    let mut covered = BTreeSet::new();
+    for &t in set {
+        if t & (ANY_LIN | ANY_ROT) != 0 {
+            out.insert(t);
+            covered.insert(t);
+            continue;
+        }
+        let (lin, ang) = (t / 27, t % 27);
+        let plain = |u: &&Token| **u & (ANY_LIN | ANY_ROT) == 0;
+        if lin != NONE_BIN && set.iter().filter(plain).filter(|&&u| u / 27 == lin).count() >= 2 {
+            out.insert(lin * 27 + NONE_BIN | ANY_ROT);
+            covered.insert(t);
+        }
+        if ang != NONE_BIN && set.iter().filter(plain).filter(|&&u| u % 27 == ang).count() >= 2 {
+            out.insert(NONE_BIN * 27 + ang | ANY_LIN);
+            covered.insert(t);
+        }
+    }
+    for &t in set.iter().filter(|t| !covered.contains(t)) {
+        // A pure translation or a pure rotation is what the performer meant; the other half
+        // (a wobble, the figurine held off-centre) may come and go.
+        let (lin, ang) = (t / 27, t % 27);
+        if t == TURN {
+            out.insert(t);
+        } else if ang == NONE_BIN {
+            out.insert(t | ANY_ROT);
+        } else if lin == NONE_BIN {
+            out.insert(t | ANY_LIN);
+        } else {
+            out.insert(t);
+        }
+    }
+    out.into_iter().collect()
+}
+
+fn merge_dups(v: Vec<Token>) -> Vec<Token> {
+    let mut out: Vec<Token> = Vec::with_capacity(v.len());
+    for t in v {
+        if out.last() != Some(&t) {
+            out.push(t);
+        }
+    }
+    out
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Op {
+    Pair(usize, usize),
+    Del(usize),
+    Ins(usize),
+}
+
+/// Edit-distance alignment of `b` to reference `a`.
+fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
+    let (n, m) = (a.len(), b.len());
+    let mut d = vec![vec![0usize; m + 1]; n + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for j in 0..=m {
+        d[0][j] = j;
+    }
+    for i in 1..=n {
+        for j in 1..=m {
+            let sub = d[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
+            d[i][j] = sub.min(d[i - 1][j] + 1).min(d[i][j - 1] + 1);
+        }
+    }
+    let (mut i, mut j) = (n, m);
+    let mut ops = Vec::new();
+    while i > 0 || j > 0 {
+        if i > 0 && j > 0 && d[i][j] == d[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]) {
+            ops.push(Op::Pair(i - 1, j - 1));
+            i -= 1;
+            j -= 1;
+        } else if i > 0 && d[i][j] == d[i - 1][j] + 1 {
+            ops.push(Op::Del(i - 1));
+            i -= 1;
+        } else {
+            ops.push(Op::Ins(j - 1));
+            j -= 1;
+        }
+    }
+    ops.reverse();
+    ops
+}
+
+/// Learns a regex from tokenized sequences; `seqs[0]` is the reference (the average doodle).
+pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
+    learn_regex_within(seqs, MAX_POSITIONS)
+}
+
+/// [`learn_regex`] with at most `budget` token positions (optional groups are dropped first).
+pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
+    let mut seqs: Vec<&Tokenized> = seqs.iter().filter(|s| !s.is_empty()).collect();
+    // Reference: the sequence with the fewest mandatory runs (the first — the average — on
+    // ties). Performances differ most in how many times they repeat a cycle; longer ones are
+    // covered by repeating the whole pattern.
+    // (At least two mandatory runs: a one-token pattern would fire on any motion.)
+    let counts: Vec<usize> = seqs.iter().map(|s| mandatory_runs(s).len()).collect();
+    let Some(best) = (0..seqs.len())
+        .filter(|&i| counts[i] >= 2)
+        .min_by_key(|&i| (counts[i], i))
+        .or_else(|| (0..seqs.len()).max_by_key(|&i| (counts[i], usize::MAX - i)))
+    else {
+        bail!("no motion found in any example (all still?)");
+    };
+    // Cyclic when some performance is closer to the reference done twice than once.
+    let mand_of = |s: &Tokenized| -> Vec<Token> { mandatory_runs(s).iter().map(|m| m.0).collect() };
+    let once = mand_of(seqs[best]);
+    let twice: Vec<Token> = once.iter().chain(once.iter()).copied().collect();
+    let cyclic = seqs.iter().any(|s| {
+        let m = mand_of(s);
+        edit_distance(&m, &twice) < edit_distance(&m, &once)
+    });
+    seqs.swap(0, best);
+    let reference = seqs[0];
+    let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
+    let n = ref_m.len();
+    let mut cols: Vec<BTreeSet<Token>> = ref_m.iter().map(|&t| BTreeSet::from([t])).collect();
+    let mut missing = vec![0usize; n];
+    // gaps[g][k]: optional tokens of sequence k before column g (g = n: after the last).
+    let mut gaps: Vec<Vec<Vec<Token>>> = vec![vec![Vec::new(); seqs.len()]; n + 1];
+    for (k, s) in seqs.iter().enumerate() {
+        let flags = mandatory_flags(s);
+        let mand = mandatory_runs(s);
+        let mt: Vec<Token> = mand.iter().map(|m| m.0).collect();
+        let ops = align(&ref_m, &mt);
+        // Column of each mandatory run of s (None = inserted → optional).
+        let mut col_of = vec![None; mt.len()];
+        for op in &ops {
+            match *op {
+                Op::Pair(i, j) => {
+                    cols[i].insert(mt[j]);
+                    col_of[j] = Some(i);
+                }
+                Op::Del(i) => missing[i] += 1,
+                Op::Ins(_) => {}
+            }
+        }
+        // Each non-column run goes to the gap before the next column-aligned run.
+        let mut is_col = vec![None; s.len()];
+        for (j, &(_, idx)) in mand.iter().enumerate() {
+            is_col[idx] = col_of[j];
+        }
+        // Runs merged into a mandatory duplicate count as that column.
+        for i in 1..s.len() {
+            if is_col[i].is_none() && flags[i] && s[i].0 == s[i - 1].0 {
+                is_col[i] = is_col[i - 1];
+            }
+        }
+        let mut next_col = vec![n; s.len() + 1];
+        for i in (0..s.len()).rev() {
+            next_col[i] = is_col[i].unwrap_or(next_col[i + 1]);
+        }
+        for i in 0..s.len() {
+            if is_col[i].is_none() {
+                gaps[next_col[i]][k].push(s[i].0);
+            }
+        }
+    }
+    // Build the expression, then shrink optional groups if over capacity.
+    let mut opt: Vec<Option<Regex>> = Vec::with_capacity(n + 1);
+    let mut opt_support: Vec<usize> = Vec::new();
+    let mut inline: Vec<Vec<Token>> = vec![Vec::new(); n + 1];
+    for (g, per_seq) in gaps.iter().enumerate() {
+        let all_same = per_seq.windows(2).all(|w| w[0] == w[1]);
+        if all_same && !per_seq[0].is_empty() {
+            inline[g] = merge_dups(per_seq[0].clone());
+            opt.push(None);
+            opt_support.push(0);
+            continue;
+        }
+        let set: BTreeSet<Token> = per_seq.iter().flatten().copied().collect();
+        if set.is_empty() {
+            opt.push(None);
+            opt_support.push(0);
+        } else {
+            let alt = Regex::Alt(generalise(&set).into_iter().map(Regex::Sym).collect());
+            opt.push(Some(Regex::Star(Box::new(simplify(alt)))));
+            opt_support.push(per_seq.iter().filter(|v| !v.is_empty()).count());
+        }
+    }
+    loop {
+        let mut items = Vec::new();
+        for g in 0..=n {
+            if let Some(o) = &opt[g] {
+                items.push(o.clone());
+            }
+            for &t in &inline[g] {
+                items.push(Regex::Plus(Box::new(Regex::Sym(t))));
+            }
+            if g < n {
+                let alt = simplify(Regex::Alt(
+                    generalise(&cols[g]).into_iter().map(Regex::Sym).collect(),
+                ));
+                // Optional only when most sequences lack it: a part one performance skipped
+                // is still part of the gesture (that performance then costs an edit).
+                items.push(if 2 * missing[g] >= seqs.len() {
+                    Regex::Star(Box::new(alt))
+                } else {
+                    Regex::Plus(Box::new(alt))
+                });
+            }
+        }
+        // The whole gesture may repeat (cyclic actions: walk, wave …; a repeated one-shot
+        // action is then one event over all repetitions).
+        let re = if cyclic {
+            Regex::Plus(Box::new(Regex::Cat(items)))
+        } else {
+            Regex::Cat(items)
+        };
+        if re.positions() <= budget {
+            if re.compile()?.min_len() == usize::MAX || re.compile()?.min_len() == 0 {
+                bail!("learnt pattern accepts nothing useful");
+            }
+            return Ok(re);
+        }
+        // Drop the least supported optional group.
+        let Some(g) = (0..=n)
+            .filter(|&g| opt[g].is_some())
+            .min_by_key(|&g| opt_support[g])
+        else {
+            bail!(
+                "the examples need {} token positions, more than the device's {MAX_POSITIONS}: \
+                 perform the action more simply or split it",
+                re.positions()
+            );
+        };
+        opt[g] = None;
+    }
+}
+
+fn simplify(alt: Regex) -> Regex {
+    match alt {
+        Regex::Alt(mut v) if v.len() == 1 => v.pop().unwrap_or(Regex::Cat(vec![])),
+        other => other,
+    }
+}
+
+/// Learns a pattern that also accepts the mirror images (left ↔ right) of the examples: a
+/// figurine action done to the other side is the same action. Falls back to the examples'
+/// own pattern when both do not fit the device together.
+pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
+    let direct = learn_regex(seqs)?;
+    let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
+    let Ok(mirror) = learn_regex(&mirrored) else {
+        return Ok(direct);
+    };
+    if mirror.to_source() == direct.to_source() {
+        return Ok(direct);
+    }
+    // Both sides within the device's positions: shed optional groups evenly if needed.
+    let half = MAX_POSITIONS / 2;
+    let (Ok(d), Ok(m)) = (
+        learn_regex_within(seqs, half),
+        learn_regex_within(&mirrored, half),
+    ) else {
+        return Ok(direct);
+    };
+    let both = Regex::Alt(vec![direct.clone(), mirror]);
+    if both.positions() <= MAX_POSITIONS {
+        Ok(both)
+    } else {
+        Ok(Regex::Alt(vec![d, m]))
+    }
+}
+
+/// Distance of the best match of `entry`'s pattern covering all of `tokens`, if within its bound.
+pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
+    let mut one = LibraryFile::default();
+    one.actions.push(entry.clone());
+    let blob = one.blob()?;
+    let lib = Library::from_bytes(&blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let Some(p) = lib.pattern(0) else {
+        return Ok(None);
+    };
+    let mut bank = MatcherBank::new();
+    let mut m = [u8::MAX; MAX_ACTIONS];
+    for &t in tokens {
+        bank.step(&lib, t, &mut m);
+    }
+    if m[0] == u8::MAX {
+        return Ok(None);
+    }
+    let back = |j: usize| tokens.len().checked_sub(j + 1).map(|i| tokens[i]);
+    for d in m[0]..=entry.max_edits {
+        if let Some((j, k)) = earliest_start(&p, d, back) {
+            if j + 1 == tokens.len() {
+                return Ok(Some(k));
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// Learns `name` from example logs; returns the entry and the per-example token strings.
+fn mirror_seq(s: &Tokenized) -> Tokenized {
+    let flags = ANY_LIN | ANY_ROT;
+    s.iter()
+        .map(|&(t, d)| (mirror_token(t & !flags) | (t & flags), d))
+        .collect()
+}
+
+fn edit_distance(a: &[Token], b: &[Token]) -> usize {
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, x) in a.iter().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, y) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(x != y))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+pub fn learn_action(
+    name: &str,
+    logs: &[PoseLog],
+    max_edits: Option<u8>,
+    mirror: bool,
+) -> Result<ActionEntry> {
+    let mut spans = Vec::new();
+    let mut seqs = Vec::new();
+    let mut raw_examples = Vec::new();
+    for log in logs {
+        raw_examples.push(tokenize_gesture(log));
+        let tok = intent_symbols(log);
+        let span = motion_span(log)
+            .map(|(t0, t1)| dtw::normalised_span(log, t0 - 0.05, t1 + 0.05))
+            .unwrap_or_default();
+        spans.push(span);
+        seqs.push(tok);
+    }
+    if mirror {
+        // Bring every example to the side of the median-length one, so a left and a right
+        // performance average and align as the same gesture (the mirror is added back below).
+        let mut order: Vec<usize> = (0..seqs.len()).collect();
+        order.sort_by_key(|&i| seqs[i].len());
+        if let Some(&r) = order.get(order.len() / 2) {
+            let reference = tokens_only(&seqs[r]);
+            for i in 0..seqs.len() {
+                let m = mirror_seq(&seqs[i]);
+                if edit_distance(&tokens_only(&m), &reference)
+                    < edit_distance(&tokens_only(&seqs[i]), &reference)
+                {
+                    seqs[i] = m;
+                    dtw::mirror_span(&mut spans[i]);
+                }
+            }
+        }
+    }
+    let avg = dtw::average(&spans);
+    let mut all = vec![intent_symbols(&avg)];
+    all.extend(seqs.iter().cloned());
+    let re = if mirror {
+        learn_regex_mirrored(&all)?
+    } else {
+        learn_regex(&all)?
+    };
+    let c = re.compile()?;
+    let examples: Vec<String> = seqs
+        .iter()
+        .map(|s| tokens_to_string(&tokens_only(s)))
+        .collect();
+    let entry = ActionEntry::new(
+        name,
+        &re.to_source(),
+        Some(max_edits.unwrap_or_else(|| default_edits(c.min_len()))),
+        examples,
+    )?;
+    Ok(entry)
+}
+
+/// Collision warnings between `entry` and the other actions of `lib`.
+pub fn collisions(lib: &LibraryFile, entry: &ActionEntry) -> Result<Vec<String>> {
+    let mut out = Vec::new();
+    for other in lib.actions.iter().filter(|a| a.name != entry.name) {
+        for ex in &entry.examples {
+            let t = parse_tokens(ex)?;
+            if let Some(d) = full_match(other, &t)? {
+                out.push(format!(
+                    "an example of `{}` ({ex}) is also matched by existing action `{}` \
+                     (pattern `{}`, distance {d})",
+                    entry.name, other.name, other.regex
+                ));
+                break;
+            }
+        }
+        for ex in &other.examples {
+            let t = parse_tokens(ex)?;
+            if let Some(d) = full_match(entry, &t)? {
+                out.push(format!(
+                    "the new pattern of `{}` also matches an example of existing action `{}` \
+                     ({ex}, distance {d})",
+                    entry.name, other.name
+                ));
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// `figurine learn`.
+pub fn run(args: &LearnArgs) -> Result<()> {
+    let mut lib = if args.library.exists() {
+        LibraryFile::read(&args.library)?
+    } else {
+        LibraryFile::default()
+    };
+    let logs = args
+        .examples
+        .iter()
+        .map(|p| PoseLog::read_path(p).map_err(anyhow::Error::from))
+        .collect::<Result<Vec<_>>>()?;
+    let entry = learn_action(&args.name, &logs, args.max_edits, !args.no_mirror)
+        .with_context(|| format!("learning `{}`", args.name))?;
+    for (p, ex) in args.examples.iter().zip(&entry.examples) {
+        let t = parse_tokens(ex)?;
+        let ok = full_match(&entry, &t)?;
+        eprintln!(
+            "  {}: {ex}  [{}]",
+            p.display(),
+            match ok {
+                Some(d) => format!("matched, distance {d}"),
+                None => "NOT matched".into(),
+            }
+        );
+    }
+    for w in collisions(&lib, &entry)? {
+        eprintln!("warning: {w}");
+    }
+    println!(
+        "{}: {}  (max {} edits)",
+        entry.name, entry.regex, entry.max_edits
+    );
+    lib.upsert(entry);
+    lib.write(&args.library)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use figurine_recognizer::token::parse_token;
+
+    fn seq(s: &str) -> Tokenized {
+        s.split_whitespace()
+            .map(|w| {
+                let (name, dur) = w.split_once(':').unwrap();
+                (parse_token(name).unwrap(), dur.parse().unwrap())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn mandatory_and_optional_tokens_make_a_pattern_accepting_every_example() {
+        let seqs = vec![
+            seq("uf:0.3 f:0.05 df:0.3"),
+            seq("uf:0.3 df:0.3"),
+            seq("uf:0.25 l:0.01 f:0.02 df:0.35"),
+            seq("u:0.1 uf:0.2 df:0.3"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        for s in &seqs {
+            assert!(
+                c.accepts(&tokens_only(s)),
+                "{} rejects {:?}",
+                re.to_source(),
+                s
+            );
+        }
+        assert!(!c.accepts(&tokens_only(&seq("df:1 uf:1"))));
+        assert!(re.to_source().contains("uf"), "{}", re.to_source());
+    }
+
+    #[test]
+    fn a_column_missing_in_one_example_becomes_optional() {
+        let seqs = vec![
+            seq("u:0.3 f:0.3 d:0.3"),
+            seq("u:0.3 f:0.3 d:0.3"),
+            seq("u:0.5 d:0.5"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert_eq!(re.to_source(), "u~+ f~+ d~+");
+    }
+
+    #[test]
+    fn tokens_disagreeing_in_one_half_become_wildcards() {
+        let set: BTreeSet<Token> = ["uf.Zp", "uf.Zn", "f", ".Yn", "d.Yn"]
+            .iter()
+            .map(|t| parse_token(t).unwrap())
+            .collect();
+        let names: Vec<String> = generalise(&set)
+            .into_iter()
+            .map(super::super::regex::symbol_name)
+            .collect();
+        assert_eq!(names.len(), 3, "{names:?}");
+        assert!(names.contains(&"uf~".to_string()) && names.contains(&"~.Yn".to_string()));
+        assert!(names.contains(&"f~".to_string()));
+    }
+
+    #[test]
+    fn mirrored_patterns_accept_the_other_side() {
+        let seqs = vec![seq("l:0.3 .Yp:0.3"), seq("l:0.3 .Yp:0.4")];
+        let re = learn_regex_mirrored(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        assert!(c.accepts(&tokens_only(&seq("l:1 .Yp:1"))));
+        assert!(c.accepts(&tokens_only(&seq("r:1 .Yn:1"))));
+        assert!(!c.accepts(&tokens_only(&seq("r:1 .Yp:1"))));
+    }
+
+    #[test]
+    fn identical_optional_sequences_become_mandatory() {
+        let seqs = vec![seq("u:1 l:0.01 d:1"), seq("u:1 l:0.01 d:1")];
+        assert_eq!(learn_regex(&seqs).unwrap().to_source(), "u~+ l~+ d~+");
+    }
+}

@@ -1,0 +1,22 @@
+//! Recognition on the host: the device recognizer run on pose logs, and everything that
+//! produces what it loads.
+//!
+//! - [`feed`]: logs → wire-quantised samples → recognizer / front end.
+//! - [`regex`]: pattern sources → Glushkov automata → device records.
+//! - [`library`] / [`effort_model`]: LIB.json and EFFORT.json, and their device blobs.
+//! - [`dtw`] + [`learn`]: `figurine learn`.
+//! - [`effort_train`] + [`report`] (+ [`font`]): `figurine train-effort`.
+//! - [`simulate`]: `figurine simulate`.
+
+pub mod dtw;
+pub mod effort_model;
+pub mod effort_train;
+pub mod eval;
+pub mod feed;
+pub mod font;
+pub mod learn;
+pub mod library;
+pub mod regex;
+pub mod report;
+pub mod simulate;
+pub mod tokens;
