@@ -49,7 +49,12 @@ fn bench(c: &mut Criterion) {
     };
     g.throughput(Throughput::Elements(d.log.samples.len() as u64));
     g.bench_function("simulate_log_default_library", |b| {
-        b.iter(|| simulate_log(&d.log, &names, &default_blob, Some(effort)).unwrap().records.len())
+        b.iter(|| {
+            simulate_log(&d.log, &names, &default_blob, Some(effort))
+                .unwrap()
+                .records
+                .len()
+        })
     });
     g.finish();
 }

@@ -110,9 +110,9 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
             let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
             let dist = dt * f64::from(r.acc.sum[18]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
-                lin * 27 + NONE_BIN | ANY_ROT
+                (lin * 27 + NONE_BIN) | ANY_ROT
             } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
-                NONE_BIN * 27 + ang | ANY_LIN
+                (NONE_BIN * 27 + ang) | ANY_LIN
             } else {
                 t
             };
@@ -169,11 +169,11 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         let (lin, ang) = (t / 27, t % 27);
         let plain = |u: &&Token| **u & (ANY_LIN | ANY_ROT) == 0;
         if lin != NONE_BIN && set.iter().filter(plain).filter(|&&u| u / 27 == lin).count() >= 2 {
-            out.insert(lin * 27 + NONE_BIN | ANY_ROT);
+            out.insert((lin * 27 + NONE_BIN) | ANY_ROT);
             covered.insert(t);
         }
         if ang != NONE_BIN && set.iter().filter(plain).filter(|&&u| u % 27 == ang).count() >= 2 {
-            out.insert(NONE_BIN * 27 + ang | ANY_LIN);
+            out.insert((NONE_BIN * 27 + ang) | ANY_LIN);
             covered.insert(t);
         }
     }
@@ -218,8 +218,8 @@ fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
     for (i, row) in d.iter_mut().enumerate() {
         row[0] = i;
     }
-    for j in 0..=m {
-        d[0][j] = j;
+    for (j, v) in d[0].iter_mut().enumerate() {
+        *v = j;
     }
     for i in 1..=n {
         for j in 1..=m {
@@ -477,6 +477,8 @@ fn edit_distance(a: &[Token], b: &[Token]) -> usize {
     prev[b.len()]
 }
 
+/// Learns action `name` from example logs (one performance each); `mirror` also accepts the
+/// left–right mirror images.
 pub fn learn_action(
     name: &str,
     logs: &[PoseLog],
