@@ -15,6 +15,11 @@ use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{Candidate, Decider, Decision, LONG_PAUSE_US};
 use crate::token::{Token, STILL};
 
+/// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
+/// ticks, and a tick opens at most one run.
+pub const MAX_RUNS_PER_SAMPLE: usize =
+    (crate::intake::MAX_GAP_US / crate::intake::TICK_US) as usize + 2;
+
 /// A recognised action, as the device reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -121,7 +126,7 @@ impl<'lib> Recognizer<'lib> {
     pub fn push(&mut self, s: &Sample, mut emit: impl FnMut(ActionEvent)) {
         self.now_us = s.t_us;
         self.now_seq = s.seq;
-        let mut opened: [Option<(u32, Token)>; 8] = [None; 8];
+        let mut opened: [Option<(u32, Token)>; MAX_RUNS_PER_SAMPLE] = [None; MAX_RUNS_PER_SAMPLE];
         let mut n_opened = 0usize;
         let mut gap = false;
         self.front.push(s, |_, ev| match ev {
@@ -402,5 +407,19 @@ mod tests {
             prop_assert_eq!((st.intake.accepted + st.intake.skipped()) as usize, stream.len());
             prop_assert_eq!(st.events, events);
         }
+    }
+}
+
+#[cfg(test)]
+mod ram {
+    use super::*;
+
+    #[test]
+    fn recognizer_state_fits_the_ram_budget() {
+        // The whole recognizer state with room for 32 actions (patterns stay in flash).
+        let size = core::mem::size_of::<Recognizer<'static>>();
+        assert!(size <= 16 * 1024, "{size} bytes");
+        extern crate std;
+        std::eprintln!("Recognizer state: {size} bytes");
     }
 }

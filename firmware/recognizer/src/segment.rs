@@ -157,7 +157,9 @@ mod tests {
         assert_eq!(d.pending().unwrap().action, 1);
         // A shorter overlapping exact match does not.
         assert_eq!(d.offer(Some(c(2, 4, 5, 0)), 0), Decision::Wait);
-        assert_eq!(d.offer(None, 0), Decision::Wait);
+        for _ in 2..LOOKAHEAD_TOKENS {
+            assert_eq!(d.offer(None, 0), Decision::Wait);
+        }
         assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
     }
 
