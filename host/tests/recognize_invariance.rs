@@ -75,7 +75,10 @@ fn size_does_not_matter() {
         // A bow or wave pivots about the figurine's feet: doubling the doodle doubles that
         // lever arm, and past `token::ARM_M` (10 cm) the swing becomes real translation. One
         // such action may change; everything else must not.
-        assert!(n + 1 >= Action::ALL.len(), "scale ×{s}: {n} of 12 actions unchanged");
+        assert!(
+            n + 1 >= Action::ALL.len(),
+            "scale ×{s}: {n} of 12 actions unchanged"
+        );
     }
 }
 

@@ -257,10 +257,22 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     let mand_of = |s: &Tokenized| -> Vec<Token> { mandatory_runs(s).iter().map(|m| m.0).collect() };
     let once = mand_of(seqs[best]);
     let twice: Vec<Token> = once.iter().chain(once.iter()).copied().collect();
-    let cyclic = seqs.iter().any(|s| {
-        let m = mand_of(s);
-        edit_distance(&m, &twice) < edit_distance(&m, &once)
-    });
+    // … or when the reference itself repeats a cycle of ≥ 2 parts (compared by their
+    // translation when they translate: a walk's rocking differs from hop to hop).
+    let key = |t: Token| {
+        if (t & 0x3ff) / 27 != NONE_BIN {
+            (t & 0x3ff) / 27
+        } else {
+            t
+        }
+    };
+    let periodic =
+        (2..=once.len() / 2).any(|p| (0..once.len() - p).all(|i| key(once[i]) == key(once[i + p])));
+    let cyclic = periodic
+        || seqs.iter().any(|s| {
+            let m = mand_of(s);
+            edit_distance(&m, &twice) < edit_distance(&m, &once)
+        });
     seqs.swap(0, best);
     let reference = seqs[0];
     let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
