@@ -307,7 +307,33 @@ impl<'lib> Recognizer<'lib> {
         let hist = self.front.history();
         let start = hist.get(c.start).map(|r| r.start);
         let end = hist.get(c.end).map(|r| r.end);
-        let acc = hist.accum(c.start, c.end);
+        // Effort is read over the whole motion phrase around the match — out to the stillness
+        // on either side (not before the previous commit) — as in training, where a gesture's
+        // features span all of its motion.
+        let mut from = c.start;
+        for _ in 0..HISTORY_RUNS {
+            let prev = from.wrapping_sub(1);
+            if prev.wrapping_sub(self.floor) > c.start.wrapping_sub(self.floor) {
+                break;
+            }
+            match hist.get(prev) {
+                Some(r) if r.token != STILL => from = prev,
+                _ => break,
+            }
+        }
+        let mut to = c.end;
+        if let Some(newest) = hist.newest() {
+            for _ in 0..HISTORY_RUNS {
+                if to == newest {
+                    break;
+                }
+                match hist.get(to.wrapping_add(1)) {
+                    Some(r) if r.token != STILL => to = to.wrapping_add(1),
+                    _ => break,
+                }
+            }
+        }
+        let acc = hist.accum(from, to);
         // Only STILL runs between the held action and this one?
         let contiguous = self.held.is_some_and(|h| {
             let mut i = h.end_run.wrapping_add(1);
