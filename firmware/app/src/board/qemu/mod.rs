@@ -1,0 +1,112 @@
+//! QEMU `mps2-an386` (Cortex-M4F at 25 MHz), run by `qemu-system-arm -M mps2-an386`.
+//!
+//! * link: CMSDK APB UART0, interrupt-driven ([`uart`]);
+//! * clock: SysTick as the embassy time driver (`systick-timer`), also the cycle stopwatch;
+//! * flash: RAM-backed NOR emulation with power-cut injection ([`flash`]);
+//! * logs: defmt over semihosting; a panic exits QEMU with status 101 (semihosting `exit`).
+//!
+//! Memory map: `hw/mps2-an386/memory.x`; details in `hw/README.md`.
+
+mod flash;
+mod uart;
+mod vectors;
+
+use cortex_m::peripheral::SYST;
+use systick_timer::SystickDriver;
+
+pub use flash::{mapped_flash, Flash, STORE_SIZE};
+pub use uart::{SerialRx, SerialTx};
+
+use super::Board;
+
+/// Board name (part of the build id).
+pub const NAME: &str = "qemu-mps2-an386";
+/// Marks the ELF as built for this board, so the e2e tests refuse a binary for another one.
+#[used]
+static BOARD_TAG: [u8; 30] = *b"figurine-board:qemu-mps2-an386";
+
+/// Core and SysTick clock, Hz.
+pub const CORE_HZ: u32 = 25_000_000;
+/// SysTick reload: the full 24 bits, so one wrap is 0.67 s (the stopwatch's range).
+const SYSTICK_RELOAD: u32 = 0x00FF_FFFF;
+/// Semihosting command-line buffer, bytes.
+const ARGS_BUF: usize = 256;
+
+embassy_time_driver::time_driver_impl!(static DRIVER: SystickDriver<4>
+    = SystickDriver::new(CORE_HZ as u64, SYSTICK_RELOAD));
+
+#[cortex_m_rt::exception]
+fn SysTick() {
+    DRIVER.systick_interrupt();
+}
+
+/// Counts core clock cycles over an interval shorter than one SysTick wrap (0.67 s).
+/// Under `qemu-system-arm -icount shift=0` one instruction takes 1 ns of virtual time, so
+/// instructions = cycles × 40 exactly (25 MHz), and counts repeat run to run.
+pub struct Stopwatch(u32);
+
+impl Stopwatch {
+    /// Starts counting.
+    pub fn start() -> Self {
+        Stopwatch(SYST::get_current())
+    }
+
+    /// Cycles since `start`.
+    pub fn cycles(&self) -> u32 {
+        self.0.wrapping_sub(SYST::get_current()) & SYSTICK_RELOAD
+    }
+}
+
+/// Reads the power-cut fault injection from the semihosting command line
+/// (`qemu-system-arm … -semihosting-config enable=on,target=native,arg=fw,arg=cut=U:K`).
+fn fault_from_args() -> Option<flash::Cut> {
+    let args = semihosting::experimental::env::args::<ARGS_BUF>().ok()?;
+    let mut cut = None;
+    for arg in (&args).flatten() {
+        if let Some(spec) = arg.strip_prefix("cut=") {
+            let (u, k) = spec.split_once(':')?;
+            cut = Some(flash::Cut {
+                upload: u.parse().ok()?,
+                after_bytes: k.parse().ok()?,
+            });
+        }
+    }
+    cut
+}
+
+/// Brings up the board: time driver, UART0 with its interrupts, the RAM-backed flash.
+pub fn init() -> Board {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        // Only reachable if init ran twice.
+        semihosting::process::exit(102)
+    };
+    DRIVER.start(&mut core.SYST);
+    let (rx, tx) = uart::init(&mut core.NVIC);
+    let flash = Flash::new(fault_from_args());
+    if let Some(c) = flash.armed() {
+        defmt::info!(
+            "fault injection armed: power cut in upload {} after {} bytes",
+            c.upload,
+            c.after_bytes
+        );
+    }
+    Board { rx, tx, flash }
+}
+
+#[cortex_m_rt::exception]
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::error!("hard fault at pc {=u32:08x}", frame.pc());
+    semihosting::process::exit(103)
+}
+
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irq: i16) {
+    defmt::error!("unexpected exception/interrupt {}", irq);
+    semihosting::process::exit(104)
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    semihosting::process::exit(101)
+}

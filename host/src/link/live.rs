@@ -1,0 +1,340 @@
+//! `figurine live`: poses from a source (a log replayed in real time, or CSV lines on stdin)
+//! streamed to one or more figurines, events printed as they arrive, the session recorded.
+//!
+//! * The session log (`--record`) gets every pose line written and flushed as it is read, so
+//!   Ctrl-C or an unplugged figurine loses nothing.
+//! * Unplug/replug: when the link drops, poses keep being recorded while the host retries
+//!   every [`RECONNECT_EVERY`]; after the handshake the stream resumes (the library persists
+//!   on the device).
+//! * Several `--port`s: one figurine per character, each in its own thread with its own
+//!   source (`--log` given once per port, in the same order); events carry a `figurine` field.
+
+use std::fs::File;
+use std::io::{BufRead, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use figurine_protocol::{HostToDevice, Pose};
+
+use super::blobs;
+use super::replay::event_indices;
+use super::{Device, PortSpec};
+use crate::events::ActionRecord;
+use crate::poselog::PoseSample;
+
+/// Pause between reconnection attempts.
+pub const RECONNECT_EVERY: Duration = Duration::from_millis(500);
+/// Sample times remembered to map event sequence numbers back to seconds (one per 16-bit seq).
+const SEQ_RING: usize = 1 << 16;
+
+/// Arguments of `figurine live`.
+#[derive(Args, Debug)]
+pub struct LiveArgs {
+    /// Serial device or tcp:HOST:PORT; repeat for several figurines (one per character).
+    #[arg(long = "port", required = true)]
+    pub ports: Vec<String>,
+    /// Pose source: a log replayed in real time, one per port; default: CSV on stdin.
+    #[arg(long = "log")]
+    pub logs: Vec<PathBuf>,
+    /// Real-time factor for `--log` sources.
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    /// Library the figurines run, for action names (default: the shipped library).
+    #[arg(long)]
+    pub library: Option<PathBuf>,
+    /// Write the session's poses here (CSV, flushed per line); with several ports, `-N` is
+    /// added before the extension for port N ≥ 2.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+}
+
+/// Parses one pose CSV data line (`t,x,y,z,qw,qx,qy,qz[,…]`); `None` for a header, a
+/// comment, a blank or malformed line.
+pub fn parse_pose_line(line: &str) -> Option<PoseSample> {
+    let line = line.trim();
+    if line.is_empty() || line.starts_with('#') {
+        return None;
+    }
+    let mut v = [0f64; 8];
+    let mut fields = line.split(',');
+    for slot in &mut v {
+        *slot = fields.next()?.trim().parse().ok()?;
+    }
+    Some(PoseSample {
+        t: v[0],
+        pos: [v[1], v[2], v[3]],
+        quat: [v[4], v[5], v[6], v[7]],
+    })
+}
+
+fn record_path(base: &Path, n: usize) -> PathBuf {
+    if n == 0 {
+        return base.to_path_buf();
+    }
+    let stem = base
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("session");
+    let ext = base.extension().and_then(|s| s.to_str()).unwrap_or("csv");
+    base.with_file_name(format!("{stem}-{}.{ext}", n + 1))
+}
+
+/// One figurine's live session.
+struct Session<'a> {
+    spec: PortSpec,
+    label: String,
+    names: &'a [String],
+    dev: Option<Device>,
+    next_retry: Instant,
+    times: Vec<f64>,
+    sent: usize,
+    record: Option<BufWriter<File>>,
+    print: &'a Mutex<std::io::Stdout>,
+    many: bool,
+}
+
+impl Session<'_> {
+    fn ensure_connected(&mut self) {
+        if self.dev.is_some() || Instant::now() < self.next_retry {
+            return;
+        }
+        match Device::connect(&self.spec) {
+            Ok(d) => {
+                eprintln!(
+                    "{}: connected (library {:08x})",
+                    self.label,
+                    d.hello().library_crc
+                );
+                self.dev = Some(d);
+            }
+            Err(e) => {
+                self.next_retry = Instant::now() + RECONNECT_EVERY;
+                eprintln!("{}: {e}; retrying", self.label);
+            }
+        }
+    }
+
+    fn lost(&mut self, e: &dyn std::fmt::Display) {
+        eprintln!(
+            "{}: {e}; reconnecting (poses are still recorded)",
+            self.label
+        );
+        self.dev = None;
+        self.next_retry = Instant::now() + RECONNECT_EVERY;
+    }
+
+    fn print_events(&mut self) {
+        let Some(dev) = self.dev.as_mut() else { return };
+        let events = match dev.take_events() {
+            Ok(e) => e,
+            Err(e) => return self.lost(&e),
+        };
+        for e in events {
+            let (start, end) = event_indices(&e, self.sent.saturating_sub(1));
+            let t = |i: usize| self.times.get(i % SEQ_RING).copied().unwrap_or(f64::NAN);
+            let rec = ActionRecord {
+                action: self
+                    .names
+                    .get(usize::from(e.action))
+                    .cloned()
+                    .unwrap_or_else(|| format!("#{}", e.action)),
+                start: t(start),
+                end: t(end),
+                time: f64::from(e.time) / 127.0,
+                weight: f64::from(e.weight) / 127.0,
+                distance: u32::from(e.distance),
+            };
+            let mut line = serde_json::to_value(&rec).unwrap_or_default();
+            if self.many {
+                line["figurine"] = serde_json::Value::String(self.label.clone());
+            }
+            if let Ok(mut out) = self.print.lock() {
+                let _ = writeln!(out, "{line}");
+                let _ = out.flush();
+            }
+        }
+    }
+
+    fn pose(&mut self, s: &PoseSample) -> Result<()> {
+        if let Some(w) = self.record.as_mut() {
+            writeln!(
+                w,
+                "{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+                s.t, s.pos[0], s.pos[1], s.pos[2], s.quat[0], s.quat[1], s.quat[2], s.quat[3]
+            )?;
+            w.flush()?;
+        }
+        let i = self.sent;
+        if let Some(slot) = self.times.get_mut(i % SEQ_RING) {
+            *slot = s.t;
+        }
+        self.sent += 1;
+        self.ensure_connected();
+        if let Ok(p) = Pose::quantize(i as u16, s.t, s.pos, s.quat) {
+            if let Some(dev) = self.dev.as_mut() {
+                if let Err(e) = dev.send(&HostToDevice::Pose(p)) {
+                    self.lost(&e);
+                }
+            }
+        }
+        self.print_events();
+        Ok(())
+    }
+
+    fn finish(&mut self) {
+        if let Some(dev) = self.dev.as_mut() {
+            if let Err(e) = dev.reset() {
+                self.lost(&e);
+            }
+        }
+        self.print_events();
+    }
+}
+
+/// One figurine's part of a `live` run.
+struct Plan {
+    spec: PortSpec,
+    source: Option<PathBuf>,
+    speed: f64,
+    record: Option<PathBuf>,
+}
+
+fn run_session(
+    plan: Plan,
+    names: &[String],
+    print: &Mutex<std::io::Stdout>,
+    many: bool,
+) -> Result<()> {
+    let Plan {
+        spec,
+        source,
+        speed,
+        record,
+    } = plan;
+    let label = spec.to_string();
+    let record = match record {
+        Some(p) => {
+            let mut w = BufWriter::new(
+                File::create(&p).with_context(|| format!("creating {}", p.display()))?,
+            );
+            writeln!(w, "t,x,y,z,qw,qx,qy,qz")?;
+            w.flush()?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut s = Session {
+        spec,
+        label,
+        names,
+        dev: None,
+        next_retry: Instant::now(),
+        times: vec![f64::NAN; SEQ_RING],
+        sent: 0,
+        record,
+        print,
+        many,
+    };
+    s.ensure_connected();
+    if let Some(dev) = s.dev.as_mut() {
+        dev.reset()?;
+        dev.take_events()?;
+    }
+    match source {
+        Some(path) => {
+            let log = crate::poselog::PoseLog::read_path(&path)?;
+            let t0 = log.samples.first().map_or(0.0, |p| p.t);
+            let start = Instant::now();
+            for p in &log.samples {
+                let due = start + Duration::from_secs_f64(((p.t - t0) / speed.max(1e-6)).max(0.0));
+                if let Some(w) = due.checked_duration_since(Instant::now()) {
+                    std::thread::sleep(w);
+                }
+                s.pose(p)?;
+            }
+        }
+        None => {
+            let stdin = std::io::stdin();
+            for line in stdin.lock().lines() {
+                if let Some(p) = parse_pose_line(&line?) {
+                    s.pose(&p)?;
+                }
+            }
+        }
+    }
+    s.finish();
+    Ok(())
+}
+
+/// `figurine live`.
+pub fn live(args: &LiveArgs) -> Result<()> {
+    let names = blobs::load(args.library.as_deref(), None)?.names;
+    let specs = args
+        .ports
+        .iter()
+        .map(|p| p.parse::<PortSpec>())
+        .collect::<Result<Vec<_>, _>>()?;
+    if specs.len() > 1 && args.logs.len() != specs.len() {
+        bail!("with several --port, give one --log per port (stdin feeds a single figurine)");
+    }
+    if args.logs.len() > specs.len() {
+        bail!("more --log than --port");
+    }
+    let print = Mutex::new(std::io::stdout());
+    let many = specs.len() > 1;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = specs
+            .into_iter()
+            .enumerate()
+            .map(|(n, spec)| {
+                let plan = Plan {
+                    spec,
+                    source: args.logs.get(n).cloned(),
+                    speed: args.speed,
+                    record: args.record.as_deref().map(|r| record_path(r, n)),
+                };
+                let (names, print) = (&names, &print);
+                scope.spawn(move || run_session(plan, names, print, many))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| bail!("a session thread panicked"))
+            })
+            .collect::<Result<Vec<()>>>()
+    })?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pose_lines_parse_and_bad_lines_are_skipped() {
+        let p = parse_pose_line("0.5,1,2,3,1,0,0,0,extra").unwrap();
+        assert_eq!(p.t, 0.5);
+        assert_eq!(p.pos, [1.0, 2.0, 3.0]);
+        assert!(parse_pose_line("t,x,y,z,qw,qx,qy,qz").is_none());
+        assert!(parse_pose_line("# comment").is_none());
+        assert!(parse_pose_line("1,2,3").is_none());
+        assert!(parse_pose_line("").is_none());
+    }
+
+    #[test]
+    fn record_paths_number_extra_figurines() {
+        assert_eq!(
+            record_path(Path::new("/tmp/s.csv"), 0),
+            PathBuf::from("/tmp/s.csv")
+        );
+        assert_eq!(
+            record_path(Path::new("/tmp/s.csv"), 1),
+            PathBuf::from("/tmp/s-2.csv")
+        );
+    }
+}
