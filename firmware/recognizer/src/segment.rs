@@ -20,7 +20,7 @@ pub const LOOKAHEAD_TOKENS: u8 = 4;
 pub const PAUSE_US: u64 = 120_000;
 /// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
 /// pauses briefly between hops without ending.
-pub const CYCLIC_PAUSE_US: u64 = 300_000;
+pub const CYCLIC_PAUSE_US: u64 = 260_000;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
 pub const LONG_PAUSE_US: u64 = 2_500_000;
 
@@ -157,7 +157,9 @@ mod tests {
         assert_eq!(d.pending().unwrap().action, 1);
         // A shorter overlapping exact match does not.
         assert_eq!(d.offer(Some(c(2, 4, 5, 0)), 0), Decision::Wait);
-        assert_eq!(d.offer(None, 0), Decision::Wait);
+        for _ in 2..LOOKAHEAD_TOKENS {
+            assert_eq!(d.offer(None, 0), Decision::Wait);
+        }
         assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
     }
 

@@ -217,11 +217,11 @@ pub fn average(spans: &[Vec<Pt>]) -> PoseLog {
                 {
                     q = q.map(|c| -c);
                 }
-                for c in 0..3 {
-                    sum[i].0[c] += w * p[c];
+                for (acc, v) in sum[i].0.iter_mut().zip(p) {
+                    *acc += w * v;
                 }
-                for c in 0..4 {
-                    sum[i].1[c] += w * q[c];
+                for (acc, v) in sum[i].1.iter_mut().zip(q) {
+                    *acc += w * v;
                 }
             }
             sum[i].2 += 1.0;
