@@ -102,18 +102,35 @@ impl Accum {
     }
 }
 
-/// The 50 log-domain features of a segment (zeros-in → ln(eps)).
+/// Scale exponent of each quantity: its value is divided by `mean speed` (linear rates) or
+/// multiplied by the path length (curvature, torsion), or divided by √path (equi-affine), so
+/// the features do not change when the same gesture is made larger or smaller. The mean world
+/// speed itself (feature 18) stays absolute: the one feature that knows the size.
+const SCALE_KIND: [u8; QUANTITIES] = [
+    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3,
+];
+
+/// The 50 log-domain, scale-free features of a segment (see [`SCALE_KIND`]).
 pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
     let mut out = [fmath::ln(FEATURE_EPS); FEATURES];
     if a.n == 0 {
         return out;
     }
     let n = a.n as f32;
+    let speed = fmath::max(a.sum[18] / n, 1e-3);
+    let path = fmath::max(speed * n * TICK_S, 1e-3);
     for i in 0..QUANTITIES {
         let mean = a.sum[i] / n;
         let var = fmath::max(a.sum_sq[i] / n - mean * mean, 0.0);
-        out[i] = fmath::ln(FEATURE_EPS + fmath::max(mean, 0.0));
-        out[QUANTITIES + i] = fmath::ln(FEATURE_EPS + fmath::sqrt(var));
+        let k = match SCALE_KIND[i] {
+            1 => 1.0 / speed,
+            2 => path,
+            3 => 1.0 / fmath::sqrt(path),
+            _ => 1.0,
+        };
+        let k_mean = if i == 18 { 1.0 } else { k };
+        out[i] = fmath::ln(FEATURE_EPS + fmath::max(mean, 0.0) * k_mean);
+        out[QUANTITIES + i] = fmath::ln(FEATURE_EPS + fmath::sqrt(var) * k);
     }
     out
 }
@@ -240,8 +257,9 @@ mod tests {
             a.add(&q);
         }
         let f = segment_features(&a);
-        assert!((f[0] - libm::logf(FEATURE_EPS + 2.0)).abs() < 1e-6);
-        assert!((f[QUANTITIES] - libm::logf(FEATURE_EPS + 1.0)).abs() < 1e-5);
+        // Relative to the (floored) mean speed of 1e-3 m/s.
+        assert!((f[0] - libm::logf(FEATURE_EPS + 2.0e3)).abs() < 1e-4);
+        assert!((f[QUANTITIES] - libm::logf(FEATURE_EPS + 1.0e3)).abs() < 1e-4);
         assert_eq!(segment_features(&Accum::new())[3], libm::logf(FEATURE_EPS));
     }
 }

@@ -15,19 +15,20 @@
 //! +0  1   n: positions (1 ≤ n ≤ MAX_POSITIONS)
 //! +1  1   max_edits: per-action edit bound (≤ MAX_EDITS, < min_len)
 //! +2  1   min_len: length of the shortest token string the pattern accepts (≥ 1)
-//! +3  1   reserved, zero
+//! +3  1   flags: bit 0 = cyclic (the whole pattern repeats, e.g. `(uf~ df~)+`); others zero
 //! +4  8   last: accepting positions
 //! +12 8   shift: positions j ≥ 2 with j ∈ follow(j − 1)
 //! +20 8   loops: positions i with i ∈ follow(i)
 //! +28 8   extra: states whose follow set has more than {i, i + 1}
-//! +36 2n  symbol of each position 1..=n (token code < STILL)
+//! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
+//!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
 //! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
 
-use crate::token::{Token, NONE_BIN, STILL};
+use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
 use crate::Error;
 
 /// Maximum number of actions in a library.
@@ -91,8 +92,8 @@ impl<'a> Pattern<'a> {
     fn extra(&self) -> u64 {
         rd_u64(self.rec, 28).unwrap_or(0)
     }
-    /// Token of position `i` (1-based); STILL (matches nothing) when out of range.
-    pub fn symbol(&self, i: usize) -> Token {
+    /// Symbol of position `i` (1-based); STILL (matches nothing) when out of range.
+    pub fn symbol(&self, i: usize) -> Symbol {
         if i == 0 {
             return STILL;
         }
@@ -113,11 +114,16 @@ impl<'a> Pattern<'a> {
     pub fn symbol_mask(&self, t: Token) -> u64 {
         let mut m = 0u64;
         for i in 1..=self.positions() {
-            if self.symbol(i) == t {
+            if symbol_matches(self.symbol(i), t) {
                 m |= 1 << i;
             }
         }
         m
+    }
+    /// Whether the action is cyclic: its whole pattern repeats (walk, wave …), so a short
+    /// pause does not end it.
+    pub fn cyclic(&self) -> bool {
+        self.rec.get(3).is_some_and(|f| f & 1 != 0)
     }
     /// Forward transition: all states reachable from a state of `d` in one step.
     #[inline]
@@ -225,15 +231,14 @@ impl<'a> Library<'a> {
 fn validate(p: Pattern<'_>) -> Result<(), Error> {
     let n = p.positions();
     let valid: u64 = ((1u64 << (n + 1)) - 1) & !1;
-    if p.rec.get(3) != Some(&0) {
-        return Err(Error::Invalid("reserved bytes"));
+    if p.rec.get(3).is_none_or(|f| f & !1 != 0) {
+        return Err(Error::Invalid("reserved flag bits"));
     }
     if p.max_edits() > MAX_EDITS {
         return Err(Error::Capacity);
     }
     for i in 1..=n {
-        let s = p.symbol(i);
-        if s >= STILL || s == NONE_BIN * 27 + NONE_BIN {
+        if !symbol_valid(p.symbol(i)) {
             return Err(Error::Invalid("pattern symbol"));
         }
     }
@@ -282,10 +287,11 @@ fn validate(p: Pattern<'_>) -> Result<(), Error> {
 #[cfg(any(feature = "std", test))]
 pub fn encode_record(
     out: &mut impl Extend<u8>,
-    symbols: &[Token],
+    symbols: &[Symbol],
     follow: &[u64],
     last: u64,
     max_edits: u8,
+    cyclic: bool,
 ) -> Result<usize, Error> {
     let n = symbols.len();
     if n == 0 || n > MAX_POSITIONS || follow.len() != n + 1 {
@@ -324,7 +330,7 @@ pub fn encode_record(
         reach = next;
         min_len += 1;
     }
-    out.extend([n as u8, max_edits, min_len, 0]);
+    out.extend([n as u8, max_edits, min_len, u8::from(cyclic)]);
     for v in [last, shift, loops, extra] {
         out.extend(v.to_le_bytes());
     }
@@ -356,7 +362,7 @@ pub(crate) mod tests {
             for (i, f) in follow.iter_mut().enumerate().skip(1) {
                 *f = (1 << i) | if i < n { 1 << (i + 1) } else { 0 };
             }
-            encode_record(&mut out, &syms, &follow, 1 << n, *k).unwrap();
+            encode_record(&mut out, &syms, &follow, 1 << n, *k, false).unwrap();
         }
         out
     }

@@ -15,6 +15,11 @@ use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{Candidate, Decider, Decision, LONG_PAUSE_US};
 use crate::token::{Token, STILL};
 
+/// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
+/// ticks, and a tick opens at most one run.
+pub const MAX_RUNS_PER_SAMPLE: usize =
+    (crate::intake::MAX_GAP_US / crate::intake::TICK_US) as usize + 2;
+
 /// A recognised action, as the device reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -121,7 +126,7 @@ impl<'lib> Recognizer<'lib> {
     pub fn push(&mut self, s: &Sample, mut emit: impl FnMut(ActionEvent)) {
         self.now_us = s.t_us;
         self.now_seq = s.seq;
-        let mut opened: [Option<(u32, Token)>; 8] = [None; 8];
+        let mut opened: [Option<(u32, Token)>; MAX_RUNS_PER_SAMPLE] = [None; MAX_RUNS_PER_SAMPLE];
         let mut n_opened = 0usize;
         let mut gap = false;
         self.front.push(s, |_, ev| match ev {
@@ -238,6 +243,8 @@ impl<'lib> Recognizer<'lib> {
                 end,
                 distance: k,
                 len: (j + 1) as u16,
+                min_len: p.min_len().min(255) as u8,
+                cyclic: p.cyclic(),
             };
             if best.is_none_or(|b| c.beats(&b)) {
                 best = Some(c);
@@ -272,5 +279,147 @@ impl<'lib> Recognizer<'lib> {
         self.bank.reset();
         self.decider.clear();
         self.floor = c.end.wrapping_add(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::pattern::tests::seq_library;
+    use proptest::prelude::*;
+    use std::vec::Vec;
+
+    /// A figurine hopping forward `hops` times (up-forward, down-forward), 120 Hz, then still.
+    fn hops(hops: usize, t0_us: u64) -> Vec<Sample> {
+        let mut out = Vec::new();
+        let rate = 120.0f32;
+        let still = 0.6f32;
+        let hop = 0.5f32;
+        let total = 2.0 * still + hops as f32 * hop;
+        let n = (total * rate) as u32;
+        for i in 0..n {
+            let t = i as f32 / rate;
+            let (mut y, mut z) = (0.0f32, 0.0f32);
+            if t > still {
+                let h = ((t - still) / hop).min(hops as f32);
+                let phase = h - libm::floorf(h);
+                z = 0.2 * h;
+                if h < hops as f32 {
+                    y = 0.1 * libm::sinf(core::f32::consts::PI * phase);
+                }
+            }
+            out.push(Sample {
+                seq: i,
+                t_us: t0_us + (t * 1e6) as u64,
+                pos: [0.3, 1.0 + y, z],
+                quat: [1.0, 0.0, 0.0, 0.0],
+            });
+        }
+        out
+    }
+
+    fn run(lib: &Library<'_>, samples: &[Sample]) -> Vec<ActionEvent> {
+        let mut rec = Recognizer::new(*lib, None);
+        let mut ev = Vec::new();
+        for s in samples {
+            rec.push(s, |e| ev.push(e));
+        }
+        rec.flush(|e| ev.push(e));
+        ev
+    }
+
+    #[test]
+    fn a_hop_sequence_is_recognised_with_its_segment() {
+        let blob = seq_library(&[(&["uf", "f", "df"], 0), (&["l", "r"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &hops(1, 5_000_000));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        let e = ev[0];
+        assert_eq!(e.action, 0);
+        // The segment lies within the hop (0.6 s … 1.1 s after the start, ± filter edges).
+        let (s, t) = (e.start_us - 5_000_000, e.end_us - 5_000_000);
+        assert!((550_000..750_000).contains(&s), "start {s}");
+        assert!((950_000..1_200_000).contains(&t), "end {t}");
+        assert!(e.decided_us > e.end_us && e.decided_us - e.end_us < 400_000);
+    }
+
+    #[test]
+    fn the_longest_action_wins() {
+        // "hop" is one hop; "double" two hops: two hops in a row are one `double`.
+        let blob = seq_library(&[
+            (&["uf", "f", "df"], 0),
+            (&["uf", "f", "df", "uf", "f", "df"], 1),
+        ]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &hops(2, 0));
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [1],
+            "{ev:?}"
+        );
+    }
+
+    fn any_sample() -> impl Strategy<Value = Sample> {
+        let f = prop_oneof![
+            8 => -3.0f32..3.0,
+            1 => Just(f32::NAN),
+            1 => Just(f32::INFINITY),
+            1 => Just(0.0f32),
+            1 => any::<f32>(),
+        ];
+        (
+            any::<u32>(),
+            0u64..3_000_000,
+            [f.clone(), f.clone(), f.clone()],
+            [f.clone(), f.clone(), f.clone(), f],
+        )
+            .prop_map(|(seq, t_us, pos, quat)| Sample {
+                seq,
+                t_us,
+                pos,
+                quat,
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn arbitrary_streams_never_panic_and_every_sample_is_counted(
+            mut stream in proptest::collection::vec(any_sample(), 0..400),
+            sorted in any::<bool>(),
+        ) {
+            if sorted {
+                stream.sort_by_key(|s| s.t_us);
+            }
+            let blob = seq_library(&[(&["uf", "df"], 0), (&["u", "d", "u"], 1), (&["f.Yp"], 0)]);
+            let lib = Library::from_bytes(&blob).unwrap();
+            let mut rec = Recognizer::new(lib, None);
+            let mut events = 0u32;
+            for s in &stream {
+                rec.push(s, |e| {
+                    assert!(e.end_us >= e.start_us);
+                    events += 1;
+                });
+            }
+            rec.flush(|_| events += 1);
+            let st = rec.stats();
+            prop_assert_eq!((st.intake.accepted + st.intake.skipped()) as usize, stream.len());
+            prop_assert_eq!(st.events, events);
+        }
+    }
+}
+
+#[cfg(test)]
+mod ram {
+    use super::*;
+
+    #[test]
+    fn recognizer_state_fits_the_ram_budget() {
+        // The whole recognizer state with room for 32 actions (patterns stay in flash).
+        let size = core::mem::size_of::<Recognizer<'static>>();
+        assert!(size <= 16 * 1024, "{size} bytes");
+        extern crate std;
+        std::eprintln!("Recognizer state: {size} bytes");
     }
 }

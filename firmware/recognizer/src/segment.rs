@@ -7,18 +7,22 @@
 //! being cut. The pending candidate is committed when
 //! - a candidate appears that starts after it (the next action has begun),
 //! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
-//! - the figurine has been still for [`PAUSE_US`] after it, or
+//! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
+//!   whose pattern repeats as a whole), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
 //! the look-ahead are replayed), so segments never overlap.
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
-pub const LOOKAHEAD_TOKENS: u8 = 3;
+pub const LOOKAHEAD_TOKENS: u8 = 4;
 /// Stillness after a candidate that commits it, µs.
-pub const PAUSE_US: u64 = 60_000;
+pub const PAUSE_US: u64 = 120_000;
+/// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
+/// pauses briefly between hops without ending.
+pub const CYCLIC_PAUSE_US: u64 = 300_000;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
-pub const LONG_PAUSE_US: u64 = 1_000_000;
+pub const LONG_PAUSE_US: u64 = 2_500_000;
 
 /// A possible action segment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +37,10 @@ pub struct Candidate {
     pub distance: u8,
     /// Non-STILL tokens covered.
     pub len: u16,
+    /// Shortest match of the action's pattern (its specificity), tokens.
+    pub min_len: u8,
+    /// The pattern can repeat as a whole (a cyclic action: walk, wave …).
+    pub cyclic: bool,
 }
 
 impl Candidate {
@@ -41,9 +49,11 @@ impl Candidate {
         2 * i32::from(self.len) - 3 * i32::from(self.distance)
     }
 
-    /// True when `self` should replace `other`.
+    /// True when `self` should replace `other`: higher merit; at equal merit the more
+    /// specific pattern (longer shortest match), then fewer edits, then the lower index.
     pub fn beats(&self, other: &Candidate) -> bool {
-        (self.merit(), other.distance, other.action) > (other.merit(), self.distance, self.action)
+        (self.merit(), self.min_len, other.distance, other.action)
+            > (other.merit(), other.min_len, self.distance, self.action)
     }
 }
 
@@ -114,7 +124,9 @@ impl Decider {
     /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`].
     pub fn stillness(&mut self, still_us: u64) -> Decision {
         match self.pending {
-            Some(p) if still_us >= PAUSE_US => Decision::Commit(p),
+            Some(p) if still_us >= if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US } => {
+                Decision::Commit(p)
+            }
             _ => Decision::Wait,
         }
     }
@@ -131,6 +143,8 @@ mod tests {
             end,
             distance,
             len: (end - start + 1) as u16,
+            min_len: 1,
+            cyclic: false,
         }
     }
 
@@ -143,7 +157,9 @@ mod tests {
         assert_eq!(d.pending().unwrap().action, 1);
         // A shorter overlapping exact match does not.
         assert_eq!(d.offer(Some(c(2, 4, 5, 0)), 0), Decision::Wait);
-        assert_eq!(d.offer(None, 0), Decision::Wait);
+        for _ in 2..LOOKAHEAD_TOKENS {
+            assert_eq!(d.offer(None, 0), Decision::Wait);
+        }
         assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
     }
 

@@ -30,15 +30,19 @@ use crate::intake::{TICK_S, TICK_US};
 pub type Token = u16;
 /// The STILL token.
 pub const STILL: Token = 729;
+/// The half-turn marker (written `O`): a rotation that continues past [`ROT_CHUNK_RAD`] in one
+/// direction about one axis goes on as a run of this token. It uses the one code of the 27×27
+/// grid that motion never produces (both halves empty).
+pub const TURN: Token = NONE_BIN * 27 + NONE_BIN;
 /// Number of distinct token codes (27 × 27 + STILL).
 pub const TOKEN_COUNT: u16 = 730;
 /// The bin code meaning "no component" for one of the two halves.
 pub const NONE_BIN: u16 = 13;
 
 /// Component share of its vector norm needed to switch a sign on.
-pub const DOM_ON: f32 = 0.45;
+pub const DOM_ON: f32 = 0.55;
 /// Component share below which an active sign switches off.
-pub const DOM_OFF: f32 = 0.30;
+pub const DOM_OFF: f32 = 0.35;
 /// Translation noise floor, m/s.
 pub const V_FLOOR_M_S: f32 = 0.07;
 /// Rotation noise floor, rad/s (≈ 34 °/s).
@@ -51,6 +55,10 @@ pub const PEAK_TAU_S: f32 = 1.0;
 pub const ARM_M: f32 = 0.03;
 /// Minimum duration of a token, µs.
 pub const MIN_TOKEN_US: u64 = 40_000;
+/// Rotation angle (rad, ≈ 229°) about one axis, in one direction, after which the current run
+/// starts again as a new run of the same token: the string then tells a spin from a turn,
+/// while angles — unlike distances — do not depend on the doodle's size.
+pub const ROT_CHUNK_RAD: f32 = 4.0;
 
 /// Per-tick decay of the peak trackers (first-order: 1 − dt/τ).
 const PEAK_DECAY: f32 = 1.0 - TICK_S / PEAK_TAU_S;
@@ -92,6 +100,9 @@ pub fn write_token<W: fmt::Write>(t: Token, w: &mut W) -> fmt::Result {
     if t >= STILL {
         return w.write_char('_');
     }
+    if t == TURN {
+        return w.write_char('O');
+    }
     let (lin, ang) = token_signs(t);
     for (i, &s) in lin.iter().enumerate() {
         if s != 0 {
@@ -110,6 +121,83 @@ pub fn write_token<W: fmt::Write>(t: Token, w: &mut W) -> fmt::Result {
     Ok(())
 }
 
+/// Pattern-symbol flag: any rotation half (written `uf~`).
+pub const ANY_ROT: u16 = 1 << 14;
+/// Pattern-symbol flag: any translation half (written `~.Yp`).
+pub const ANY_LIN: u16 = 1 << 15;
+
+/// A pattern symbol: a token code, possibly with one wildcard half ([`ANY_ROT`] with the
+/// rotation half empty, or [`ANY_LIN`] with the translation half empty).
+pub type Symbol = u16;
+
+/// Whether a pattern symbol is well formed.
+pub fn symbol_valid(s: Symbol) -> bool {
+    let code = s & 0x3ff;
+    if code >= STILL {
+        return false;
+    }
+    match s & (ANY_ROT | ANY_LIN) {
+        0 => s == code,
+        _ if code == TURN => false,
+        ANY_ROT => code % 27 == NONE_BIN,
+        ANY_LIN => code / 27 == NONE_BIN,
+        _ => false,
+    }
+}
+
+/// Whether token `t` matches pattern symbol `s`.
+#[inline]
+pub fn symbol_matches(s: Symbol, t: Token) -> bool {
+    if t >= STILL {
+        return false;
+    }
+    let code = s & 0x3ff;
+    if s & ANY_ROT != 0 {
+        code / 27 == t / 27
+    } else if s & ANY_LIN != 0 {
+        code % 27 == t % 27
+    } else {
+        code == t
+    }
+}
+
+/// Mirror image of a token under the left–right reflection of the figurine (x → −x):
+/// translation x flips; angular velocity, a pseudovector, keeps x and flips y and z.
+pub fn mirror_token(t: Token) -> Token {
+    if t >= STILL || t == TURN {
+        return t;
+    }
+    let (l, a) = token_signs(t);
+    token_from_signs([-l[0], l[1], l[2]], [a[0], -a[1], -a[2]])
+}
+
+/// Writes a pattern symbol (a token name, `uf~` or `~.Yp`).
+pub fn write_symbol<W: fmt::Write>(s: Symbol, w: &mut W) -> fmt::Result {
+    if s & ANY_LIN != 0 {
+        w.write_char('~')?;
+    }
+    write_token(s & 0x3ff, w)?;
+    if s & ANY_ROT != 0 {
+        w.write_char('~')?;
+    }
+    Ok(())
+}
+
+/// Parses a pattern symbol; `None` if malformed.
+pub fn parse_symbol(name: &str) -> Option<Symbol> {
+    if let Some(rest) = name.strip_suffix('~') {
+        let t = parse_token(rest)?;
+        let s = t | ANY_ROT;
+        return symbol_valid(s).then_some(s);
+    }
+    if let Some(rest) = name.strip_prefix('~') {
+        let t = parse_token(rest)?;
+        let s = t | ANY_LIN;
+        return symbol_valid(s).then_some(s);
+    }
+    parse_token(name).filter(|&t| t != STILL)
+}
+
 /// A token as a `Display` value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TokenName(pub Token);
@@ -124,6 +212,9 @@ impl fmt::Display for TokenName {
 pub fn parse_token(s: &str) -> Option<Token> {
     if s == "_" {
         return Some(STILL);
+    }
+    if s == "O" {
+        return Some(TURN);
     }
     let b = s.as_bytes();
     let mut lin = [0i8; 3];
@@ -209,6 +300,7 @@ pub struct Tokenizer {
     ang: [i8; 3],
     current: Option<Token>,
     candidate: Option<(Token, u64)>,
+    turned: [f32; 3],
 }
 
 impl Default for Tokenizer {
@@ -247,6 +339,7 @@ impl Tokenizer {
             ang: [0; 3],
             current: None,
             candidate: None,
+            turned: [0.0; 3],
         }
     }
 
@@ -276,7 +369,28 @@ impl Tokenizer {
             self.current = Some(raw);
             return TokenStep::NewToken { token: raw };
         };
+        // Angle turned about each axis while its sign stays the same, across token changes.
+        let mut chunk = false;
+        for i in 0..3 {
+            if self.ang[i] == 0
+                || (self.turned[i] != 0.0 && (self.turned[i] > 0.0) != (self.ang[i] > 0))
+            {
+                self.turned[i] = 0.0;
+            }
+            if self.ang[i] != 0 {
+                self.turned[i] += k.w[i] * TICK_S;
+                if fmath::abs(self.turned[i]) >= ROT_CHUNK_RAD {
+                    self.turned[i] = 0.0;
+                    chunk = true;
+                }
+            }
+        }
         if raw == cur {
+            if chunk && self.candidate.is_none() && raw != STILL {
+                // A marker run opens; `current` stays the rotating token, so the marker run
+                // lasts while the rotation does (see `TURN`).
+                return TokenStep::NewToken { token: TURN };
+            }
             return if self.candidate.take().is_some() {
                 TokenStep::BlipMerged {
                     starts_candidate: false,
@@ -322,9 +436,6 @@ mod tests {
         for t in 0..TOKEN_COUNT {
             let mut s = String::new();
             write_token(t, &mut s).unwrap();
-            if t == NONE_BIN * 27 + NONE_BIN {
-                continue; // never produced: both halves empty is STILL
-            }
             assert_eq!(parse_token(&s), Some(t), "{t} {s}");
         }
         assert_eq!(parse_token("uf"), Some(token_from_signs([0, 1, 1], [0; 3])));

@@ -94,6 +94,14 @@ pub fn normalised_span(log: &PoseLog, t0: f64, t1: f64) -> Vec<Pt> {
     out
 }
 
+/// Reflects a normalised span left ↔ right (x → −x; rotations about y and z reverse).
+pub fn mirror_span(span: &mut [Pt]) {
+    for (p, q) in span.iter_mut() {
+        p[0] = -p[0];
+        *q = [q[0], q[1], -q[2], -q[3]];
+    }
+}
+
 fn extent(pts: &[Pt]) -> f64 {
     let n = pts.len().max(1) as f64;
     let c = [0, 1, 2].map(|k| pts.iter().map(|p| p.0[k]).sum::<f64>() / n);
@@ -209,11 +217,11 @@ pub fn average(spans: &[Vec<Pt>]) -> PoseLog {
                 {
                     q = q.map(|c| -c);
                 }
-                for c in 0..3 {
-                    sum[i].0[c] += w * p[c];
+                for (acc, v) in sum[i].0.iter_mut().zip(p) {
+                    *acc += w * v;
                 }
-                for c in 0..4 {
-                    sum[i].1[c] += w * q[c];
+                for (acc, v) in sum[i].1.iter_mut().zip(q) {
+                    *acc += w * v;
                 }
             }
             sum[i].2 += 1.0;

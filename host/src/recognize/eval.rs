@@ -63,6 +63,9 @@ pub struct EvalArgs {
     /// Save the trained effort model here.
     #[arg(long)]
     pub save_effort: Option<PathBuf>,
+    /// Print the token string of every misrecognised isolated gesture.
+    #[arg(long)]
+    pub verbose: bool,
 }
 
 /// Learns every synth action from `n` generated examples.
@@ -77,7 +80,7 @@ pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<Library
             None,
         );
         let logs: Vec<_> = docs.into_iter().map(|d| d.log).collect();
-        lib.upsert(learn_action(action.name(), &logs, None)?);
+        lib.upsert(learn_action(action.name(), &logs, None, true)?);
     }
     Ok(lib)
 }
@@ -215,6 +218,14 @@ pub fn evaluate(
                 s_ok += usize::from(t && w);
                 f.latencies.push(main.map_or(0.0, |e| e.decided - l.end));
             } else {
+                if args.verbose {
+                    let t = super::learn::tokenize_gesture(&d.log);
+                    eprintln!(
+                        "{} -> {got}: {}",
+                        l.action,
+                        super::library::tokens_to_string(&super::learn::tokens_only(&t))
+                    );
+                }
                 *conf.entry((l.action.clone(), got)).or_default() += 1;
             }
         }
@@ -238,6 +249,14 @@ pub fn evaluate(
         let evs = run_doodle(&d, &names, &blob, effort)?;
         n_ev += evs.len();
         n_lab += d.labels.len();
+        if args.verbose && k < 3 {
+            for l in &d.labels {
+                eprintln!("  label {:<9} {:7.2} {:7.2}", l.action, l.start, l.end);
+            }
+            for e in &evs {
+                eprintln!("  event {:<9} {:7.2} {:7.2}", e.action, e.start, e.end);
+            }
+        }
         let mut used = vec![false; evs.len()];
         for l in &d.labels {
             let best = evs

@@ -21,7 +21,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
-use figurine_recognizer::token::{Token, STILL};
+use figurine_recognizer::token::{
+    mirror_token, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
+};
 use figurine_recognizer::Library;
 
 use super::dtw;
@@ -45,6 +47,9 @@ pub struct LearnArgs {
     /// Edit bound (default: one per three tokens of the shortest match, at most 3).
     #[arg(long)]
     pub max_edits: Option<u8>,
+    /// Do not also accept the mirror image (left ↔ right) of the examples.
+    #[arg(long)]
+    pub no_mirror: bool,
     /// Example logs, one performance each (three are usually enough).
     #[arg(required = true)]
     pub examples: Vec<PathBuf>,
@@ -79,6 +84,46 @@ fn motion_span(log: &PoseLog) -> Option<(f64, f64)> {
     Some((clock.time_of(first.start.0), clock.time_of(last.end.0)))
 }
 
+/// Rotation (rad) below which a run's rotation half is a wobble, not part of the gesture.
+pub const INCIDENTAL_ANGLE_RAD: f64 = 0.35;
+/// Share of the gesture's path length below which a run's translation half is incidental.
+pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
+
+/// Like [`tokenize_gesture`], but each run is written as the symbol of what it means: a half
+/// that barely moved (a rotation of less than [`INCIDENTAL_ANGLE_RAD`], a translation shorter
+/// than [`INCIDENTAL_PATH_SHARE`] of the path) becomes a wildcard, so `d.Xp` with a 5° tilt is
+/// learnt as `d~`.
+pub fn intent_symbols(log: &PoseLog) -> Tokenized {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g: Vec<_> = gesture_runs(&runs)
+        .iter()
+        .filter(|r| r.token != STILL)
+        .copied()
+        .collect();
+    let dt = f64::from(figurine_recognizer::intake::TICK_S);
+    let path: f64 = g.iter().map(|r| f64::from(r.acc.sum[18]) * dt).sum();
+    g.iter()
+        .map(|r| {
+            let t = r.token;
+            let (lin, ang) = (t / 27, t % 27);
+            let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
+            let dist = dt * f64::from(r.acc.sum[18]);
+            let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
+                (lin * 27 + NONE_BIN) | ANY_ROT
+            } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
+                (NONE_BIN * 27 + ang) | ANY_LIN
+            } else {
+                t
+            };
+            (
+                sym,
+                (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01,
+            )
+        })
+        .collect()
+}
+
 /// Token string as the automata see it (STILL already removed).
 pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
     t.iter().map(|x| x.0).collect()
@@ -86,7 +131,67 @@ pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
 
 fn mandatory_flags(t: &Tokenized) -> Vec<bool> {
     let total: f64 = t.iter().map(|x| x.1).sum();
-    t.iter().map(|x| x.1 >= MANDATORY_SHARE * total).collect()
+    // The half-turn marker is always deliberate, however short its run.
+    t.iter()
+        .map(|x| x.0 == TURN || x.1 >= MANDATORY_SHARE * total)
+        .collect()
+}
+
+/// Mandatory runs (token, index in `t`); a repeat of the previous mandatory token separated
+/// from it only by optional runs is the same gesture part and is merged.
+fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
+    let flags = mandatory_flags(t);
+    let mut mand: Vec<(Token, usize)> = Vec::new();
+    for (i, (x, f)) in t.iter().zip(&flags).enumerate() {
+        if !*f {
+            continue;
+        }
+        match mand.last() {
+            Some(&(prev, at)) if prev == x.0 && at + 1 < i => {}
+            _ => mand.push((x.0, i)),
+        }
+    }
+    mand
+}
+
+/// Replaces tokens that differ only in one half by a wildcard symbol (`uf~`, `~.Yp`) when at
+/// least two of them share the other half: the examples disagree there, so it is not part of
+/// the gesture.
+pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
+    let mut out = BTreeSet::new();
+    let mut covered = BTreeSet::new();
+    for &t in set {
+        if t & (ANY_LIN | ANY_ROT) != 0 {
+            out.insert(t);
+            covered.insert(t);
+            continue;
+        }
+        let (lin, ang) = (t / 27, t % 27);
+        let plain = |u: &&Token| **u & (ANY_LIN | ANY_ROT) == 0;
+        if lin != NONE_BIN && set.iter().filter(plain).filter(|&&u| u / 27 == lin).count() >= 2 {
+            out.insert((lin * 27 + NONE_BIN) | ANY_ROT);
+            covered.insert(t);
+        }
+        if ang != NONE_BIN && set.iter().filter(plain).filter(|&&u| u % 27 == ang).count() >= 2 {
+            out.insert((NONE_BIN * 27 + ang) | ANY_LIN);
+            covered.insert(t);
+        }
+    }
+    for &t in set.iter().filter(|t| !covered.contains(t)) {
+        // A pure translation or a pure rotation is what the performer meant; the other half
+        // (a wobble, the figurine held off-centre) may come and go.
+        let (lin, ang) = (t / 27, t % 27);
+        if t == TURN {
+            out.insert(t);
+        } else if ang == NONE_BIN {
+            out.insert(t | ANY_ROT);
+        } else if lin == NONE_BIN {
+            out.insert(t | ANY_LIN);
+        } else {
+            out.insert(t);
+        }
+    }
+    out.into_iter().collect()
 }
 
 fn merge_dups(v: Vec<Token>) -> Vec<Token> {
@@ -113,8 +218,8 @@ fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
     for (i, row) in d.iter_mut().enumerate() {
         row[0] = i;
     }
-    for j in 0..=m {
-        d[0][j] = j;
+    for (j, v) in d[0].iter_mut().enumerate() {
+        *v = j;
     }
     for i in 1..=n {
         for j in 1..=m {
@@ -143,33 +248,43 @@ fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
 
 /// Learns a regex from tokenized sequences; `seqs[0]` is the reference (the average doodle).
 pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
-    let seqs: Vec<&Tokenized> = seqs.iter().filter(|s| !s.is_empty()).collect();
-    let Some(reference) = seqs.first() else {
+    learn_regex_within(seqs, MAX_POSITIONS)
+}
+
+/// [`learn_regex`] with at most `budget` token positions (optional groups are dropped first).
+pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
+    let mut seqs: Vec<&Tokenized> = seqs.iter().filter(|s| !s.is_empty()).collect();
+    // Reference: the sequence with the fewest mandatory runs (the first — the average — on
+    // ties). Performances differ most in how many times they repeat a cycle; longer ones are
+    // covered by repeating the whole pattern.
+    // (At least two mandatory runs: a one-token pattern would fire on any motion.)
+    let counts: Vec<usize> = seqs.iter().map(|s| mandatory_runs(s).len()).collect();
+    let Some(best) = (0..seqs.len())
+        .filter(|&i| counts[i] >= 2)
+        .min_by_key(|&i| (counts[i], i))
+        .or_else(|| (0..seqs.len()).max_by_key(|&i| (counts[i], usize::MAX - i)))
+    else {
         bail!("no motion found in any example (all still?)");
     };
-    let ref_flags = mandatory_flags(reference);
-    let ref_m: Vec<Token> = merge_dups(
-        reference
-            .iter()
-            .zip(&ref_flags)
-            .filter(|(_, &f)| f)
-            .map(|(t, _)| t.0)
-            .collect(),
-    );
+    // Cyclic when some performance is closer to the reference done twice than once.
+    let mand_of = |s: &Tokenized| -> Vec<Token> { mandatory_runs(s).iter().map(|m| m.0).collect() };
+    let once = mand_of(seqs[best]);
+    let twice: Vec<Token> = once.iter().chain(once.iter()).copied().collect();
+    let cyclic = seqs.iter().any(|s| {
+        let m = mand_of(s);
+        edit_distance(&m, &twice) < edit_distance(&m, &once)
+    });
+    seqs.swap(0, best);
+    let reference = seqs[0];
+    let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
     let n = ref_m.len();
     let mut cols: Vec<BTreeSet<Token>> = ref_m.iter().map(|&t| BTreeSet::from([t])).collect();
-    let mut missing = vec![false; n];
+    let mut missing = vec![0usize; n];
     // gaps[g][k]: optional tokens of sequence k before column g (g = n: after the last).
     let mut gaps: Vec<Vec<Vec<Token>>> = vec![vec![Vec::new(); seqs.len()]; n + 1];
     for (k, s) in seqs.iter().enumerate() {
         let flags = mandatory_flags(s);
-        // Mandatory runs (with their index in s), duplicates merged.
-        let mut mand: Vec<(Token, usize)> = Vec::new();
-        for (i, (t, f)) in s.iter().zip(&flags).enumerate() {
-            if *f && mand.last().map(|m| m.0) != Some(t.0) {
-                mand.push((t.0, i));
-            }
-        }
+        let mand = mandatory_runs(s);
         let mt: Vec<Token> = mand.iter().map(|m| m.0).collect();
         let ops = align(&ref_m, &mt);
         // Column of each mandatory run of s (None = inserted → optional).
@@ -180,7 +295,7 @@ pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
                     cols[i].insert(mt[j]);
                     col_of[j] = Some(i);
                 }
-                Op::Del(i) => missing[i] = true,
+                Op::Del(i) => missing[i] += 1,
                 Op::Ins(_) => {}
             }
         }
@@ -222,7 +337,7 @@ pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
             opt.push(None);
             opt_support.push(0);
         } else {
-            let alt = Regex::Alt(set.iter().map(|&t| Regex::Sym(t)).collect());
+            let alt = Regex::Alt(generalise(&set).into_iter().map(Regex::Sym).collect());
             opt.push(Some(Regex::Star(Box::new(simplify(alt)))));
             opt_support.push(per_seq.iter().filter(|v| !v.is_empty()).count());
         }
@@ -237,16 +352,26 @@ pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
                 items.push(Regex::Plus(Box::new(Regex::Sym(t))));
             }
             if g < n {
-                let alt = simplify(Regex::Alt(cols[g].iter().map(|&t| Regex::Sym(t)).collect()));
-                items.push(if missing[g] {
+                let alt = simplify(Regex::Alt(
+                    generalise(&cols[g]).into_iter().map(Regex::Sym).collect(),
+                ));
+                // Optional only when most sequences lack it: a part one performance skipped
+                // is still part of the gesture (that performance then costs an edit).
+                items.push(if 2 * missing[g] >= seqs.len() {
                     Regex::Star(Box::new(alt))
                 } else {
                     Regex::Plus(Box::new(alt))
                 });
             }
         }
-        let re = Regex::Cat(items);
-        if re.positions() <= MAX_POSITIONS {
+        // The whole gesture may repeat (cyclic actions: walk, wave …; a repeated one-shot
+        // action is then one event over all repetitions).
+        let re = if cyclic {
+            Regex::Plus(Box::new(Regex::Cat(items)))
+        } else {
+            Regex::Cat(items)
+        };
+        if re.positions() <= budget {
             if re.compile()?.min_len() == usize::MAX || re.compile()?.min_len() == 0 {
                 bail!("learnt pattern accepts nothing useful");
             }
@@ -271,6 +396,34 @@ fn simplify(alt: Regex) -> Regex {
     match alt {
         Regex::Alt(mut v) if v.len() == 1 => v.pop().unwrap_or(Regex::Cat(vec![])),
         other => other,
+    }
+}
+
+/// Learns a pattern that also accepts the mirror images (left ↔ right) of the examples: a
+/// figurine action done to the other side is the same action. Falls back to the examples'
+/// own pattern when both do not fit the device together.
+pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
+    let direct = learn_regex(seqs)?;
+    let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
+    let Ok(mirror) = learn_regex(&mirrored) else {
+        return Ok(direct);
+    };
+    if mirror.to_source() == direct.to_source() {
+        return Ok(direct);
+    }
+    // Both sides within the device's positions: shed optional groups evenly if needed.
+    let half = MAX_POSITIONS / 2;
+    let (Ok(d), Ok(m)) = (
+        learn_regex_within(seqs, half),
+        learn_regex_within(&mirrored, half),
+    ) else {
+        return Ok(direct);
+    };
+    let both = Regex::Alt(vec![direct.clone(), mirror]);
+    if both.positions() <= MAX_POSITIONS {
+        Ok(both)
+    } else {
+        Ok(Regex::Alt(vec![d, m]))
     }
 }
 
@@ -303,20 +456,73 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
 }
 
 /// Learns `name` from example logs; returns the entry and the per-example token strings.
-pub fn learn_action(name: &str, logs: &[PoseLog], max_edits: Option<u8>) -> Result<ActionEntry> {
+fn mirror_seq(s: &Tokenized) -> Tokenized {
+    let flags = ANY_LIN | ANY_ROT;
+    s.iter()
+        .map(|&(t, d)| (mirror_token(t & !flags) | (t & flags), d))
+        .collect()
+}
+
+fn edit_distance(a: &[Token], b: &[Token]) -> usize {
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, x) in a.iter().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, y) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(x != y))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Learns action `name` from example logs (one performance each); `mirror` also accepts the
+/// left–right mirror images.
+pub fn learn_action(
+    name: &str,
+    logs: &[PoseLog],
+    max_edits: Option<u8>,
+    mirror: bool,
+) -> Result<ActionEntry> {
     let mut spans = Vec::new();
     let mut seqs = Vec::new();
+    let mut raw_examples = Vec::new();
     for log in logs {
-        let tok = tokenize_gesture(log);
-        if let Some((t0, t1)) = motion_span(log) {
-            spans.push(dtw::normalised_span(log, t0 - 0.05, t1 + 0.05));
-        }
+        raw_examples.push(tokenize_gesture(log));
+        let tok = intent_symbols(log);
+        let span = motion_span(log)
+            .map(|(t0, t1)| dtw::normalised_span(log, t0 - 0.05, t1 + 0.05))
+            .unwrap_or_default();
+        spans.push(span);
         seqs.push(tok);
     }
+    if mirror {
+        // Bring every example to the side of the median-length one, so a left and a right
+        // performance average and align as the same gesture (the mirror is added back below).
+        let mut order: Vec<usize> = (0..seqs.len()).collect();
+        order.sort_by_key(|&i| seqs[i].len());
+        if let Some(&r) = order.get(order.len() / 2) {
+            let reference = tokens_only(&seqs[r]);
+            for i in 0..seqs.len() {
+                let m = mirror_seq(&seqs[i]);
+                if edit_distance(&tokens_only(&m), &reference)
+                    < edit_distance(&tokens_only(&seqs[i]), &reference)
+                {
+                    seqs[i] = m;
+                    dtw::mirror_span(&mut spans[i]);
+                }
+            }
+        }
+    }
     let avg = dtw::average(&spans);
-    let mut all = vec![tokenize_gesture(&avg)];
+    let mut all = vec![intent_symbols(&avg)];
     all.extend(seqs.iter().cloned());
-    let re = learn_regex(&all)?;
+    let re = if mirror {
+        learn_regex_mirrored(&all)?
+    } else {
+        learn_regex(&all)?
+    };
     let c = re.compile()?;
     let examples: Vec<String> = seqs
         .iter()
@@ -373,7 +579,7 @@ pub fn run(args: &LearnArgs) -> Result<()> {
         .iter()
         .map(|p| PoseLog::read_path(p).map_err(anyhow::Error::from))
         .collect::<Result<Vec<_>>>()?;
-    let entry = learn_action(&args.name, &logs, args.max_edits)
+    let entry = learn_action(&args.name, &logs, args.max_edits, !args.no_mirror)
         .with_context(|| format!("learning `{}`", args.name))?;
     for (p, ex) in args.examples.iter().zip(&entry.examples) {
         let t = parse_tokens(ex)?;
@@ -443,12 +649,37 @@ mod tests {
             seq("u:0.5 d:0.5"),
         ];
         let re = learn_regex(&seqs).unwrap();
-        assert_eq!(re.to_source(), "u+ f* d+");
+        assert_eq!(re.to_source(), "u~+ f~+ d~+");
+    }
+
+    #[test]
+    fn tokens_disagreeing_in_one_half_become_wildcards() {
+        let set: BTreeSet<Token> = ["uf.Zp", "uf.Zn", "f", ".Yn", "d.Yn"]
+            .iter()
+            .map(|t| parse_token(t).unwrap())
+            .collect();
+        let names: Vec<String> = generalise(&set)
+            .into_iter()
+            .map(super::super::regex::symbol_name)
+            .collect();
+        assert_eq!(names.len(), 3, "{names:?}");
+        assert!(names.contains(&"uf~".to_string()) && names.contains(&"~.Yn".to_string()));
+        assert!(names.contains(&"f~".to_string()));
+    }
+
+    #[test]
+    fn mirrored_patterns_accept_the_other_side() {
+        let seqs = vec![seq("l:0.3 .Yp:0.3"), seq("l:0.3 .Yp:0.4")];
+        let re = learn_regex_mirrored(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        assert!(c.accepts(&tokens_only(&seq("l:1 .Yp:1"))));
+        assert!(c.accepts(&tokens_only(&seq("r:1 .Yn:1"))));
+        assert!(!c.accepts(&tokens_only(&seq("r:1 .Yp:1"))));
     }
 
     #[test]
     fn identical_optional_sequences_become_mandatory() {
         let seqs = vec![seq("u:1 l:0.01 d:1"), seq("u:1 l:0.01 d:1")];
-        assert_eq!(learn_regex(&seqs).unwrap().to_source(), "u+ l+ d+");
+        assert_eq!(learn_regex(&seqs).unwrap().to_source(), "u~+ l~+ d~+");
     }
 }

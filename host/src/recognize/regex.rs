@@ -11,13 +11,13 @@
 
 use anyhow::{bail, Result};
 use figurine_recognizer::pattern::{encode_record, MAX_EDITS, MAX_POSITIONS};
-use figurine_recognizer::token::{parse_token, Token, TokenName, STILL};
+use figurine_recognizer::token::{parse_symbol, symbol_matches, write_symbol, Symbol, Token};
 
 /// Parsed regular expression.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Regex {
-    /// One token.
-    Sym(Token),
+    /// One pattern symbol (a token, or a token with a wildcard half).
+    Sym(Symbol),
     /// Concatenation.
     Cat(Vec<Regex>),
     /// Alternation.
@@ -33,12 +33,14 @@ pub enum Regex {
 /// The compiled (Glushkov) automaton of a pattern.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Compiled {
-    /// Token of positions 1..=n.
-    pub symbols: Vec<Token>,
+    /// Symbol of positions 1..=n.
+    pub symbols: Vec<Symbol>,
     /// Follow sets of states 0..=n (bit i = state i; state 0 initial).
     pub follow: Vec<u64>,
     /// Accepting positions.
     pub last: u64,
+    /// The whole expression is a `(…)+`: a cyclic action.
+    pub cyclic: bool,
 }
 
 struct Parser<'a> {
@@ -109,23 +111,36 @@ impl Parser<'_> {
                 self.pos += 1;
                 Ok(inner)
             }
-            Some(c) if c.is_ascii_alphabetic() || c == '.' || c == '_' => {
+            Some(c) if is_name_char(c) => {
                 let rest = &self.src[self.pos..];
-                let len = rest
-                    .find(|c: char| !(c.is_ascii_alphabetic() || c == '.' || c == '_'))
-                    .unwrap_or(rest.len());
+                let len = rest.find(|c: char| !is_name_char(c)).unwrap_or(rest.len());
                 let name = &rest[..len];
                 self.pos += len;
-                match parse_token(name) {
-                    Some(STILL) => bail!("STILL (`_`) cannot appear in a pattern"),
+                if name == "_" {
+                    bail!("STILL (`_`) cannot appear in a pattern");
+                }
+                match parse_symbol(name) {
                     Some(t) => Ok(Regex::Sym(t)),
-                    None => bail!("`{name}` is not a token name (e.g. `uf`, `d`, `.Yp`, `f.Zn`)"),
+                    None => bail!(
+                        "`{name}` is not a token name (e.g. `uf`, `d`, `.Yp`, `f.Zn`, `uf~`, `~.Yp`)"
+                    ),
                 }
             }
             Some(c) => bail!("unexpected `{c}` at byte {} of `{}`", self.pos, self.src),
             None => bail!("unexpected end of `{}`", self.src),
         }
     }
+}
+
+fn is_name_char(c: char) -> bool {
+    c.is_ascii_alphabetic() || c == '.' || c == '_' || c == '~'
+}
+
+/// A symbol's name.
+pub fn symbol_name(s: Symbol) -> String {
+    let mut out = String::new();
+    let _ = write_symbol(s, &mut out);
+    out
 }
 
 impl Regex {
@@ -146,7 +161,7 @@ impl Regex {
     /// Canonical source text (parses back to the same expression).
     pub fn to_source(&self) -> String {
         match self {
-            Regex::Sym(t) => TokenName(*t).to_string(),
+            Regex::Sym(t) => symbol_name(*t),
             Regex::Cat(v) => v
                 .iter()
                 .map(|r| match r {
@@ -192,6 +207,8 @@ impl Regex {
             symbols,
             follow,
             last: g.last,
+            cyclic: matches!(self, Regex::Plus(_))
+                || matches!(self, Regex::Alt(v) if v.iter().all(|r| matches!(r, Regex::Plus(_)))),
         })
     }
 }
@@ -302,8 +319,15 @@ impl Compiled {
     /// The device record (see `figurine_recognizer::pattern` for the layout).
     pub fn record(&self, max_edits: u8) -> Result<Vec<u8>> {
         let mut out = Vec::new();
-        encode_record(&mut out, &self.symbols, &self.follow, self.last, max_edits)
-            .map_err(|e| anyhow::anyhow!("cannot encode pattern: {e}"))?;
+        encode_record(
+            &mut out,
+            &self.symbols,
+            &self.follow,
+            self.last,
+            max_edits,
+            self.cyclic,
+        )
+        .map_err(|e| anyhow::anyhow!("cannot encode pattern: {e}"))?;
         Ok(out)
     }
 
@@ -319,7 +343,7 @@ impl Compiled {
             }
             d = 0;
             for (i, &s) in self.symbols.iter().enumerate() {
-                if s == t && next & (1 << (i + 1)) != 0 {
+                if symbol_matches(s, t) && next & (1 << (i + 1)) != 0 {
                     d |= 1 << (i + 1);
                 }
             }
@@ -334,6 +358,7 @@ impl Compiled {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use figurine_recognizer::token::parse_token;
 
     fn toks(s: &str) -> Vec<Token> {
         s.split_whitespace()
@@ -343,7 +368,13 @@ mod tests {
 
     #[test]
     fn parses_and_prints_round_trip() {
-        for src in ["uf df", "(uf df)+ u*", "f+ (l|r)* .Yp?", "(u|d)+ (f b)*"] {
+        for src in [
+            "uf df",
+            "(uf df)+ u*",
+            "f+ (l|r)* .Yp?",
+            "(u|d)+ (f b)*",
+            "uf~ ~.Yp+",
+        ] {
             let r = Regex::parse(src).unwrap();
             assert_eq!(Regex::parse(&r.to_source()).unwrap(), r, "{src}");
         }
@@ -364,6 +395,8 @@ mod tests {
         assert!(c.accepts(&toks("f l r l b")));
         assert!(c.accepts(&toks("f b")));
         assert!(!c.accepts(&toks("f l")));
+        let c = Regex::parse("uf~+ ~.Yn").unwrap().compile().unwrap();
+        assert!(c.accepts(&toks("uf.Zp uf d.Yn")));
     }
 
     #[test]

@@ -18,6 +18,7 @@ const TIME_C: Rgb<u8> = Rgb([215, 95, 40]);
 const WEIGHT_C: Rgb<u8> = Rgb([40, 110, 200]);
 const DIM: Rgb<u8> = Rgb([180, 180, 190]);
 
+#[allow(clippy::too_many_arguments)] // a plot panel: position, size, data, style
 fn bars(
     img: &mut RgbImage,
     x: i64,
@@ -45,7 +46,7 @@ fn bars(
         img,
         x,
         y + h + 16,
-        "FEATURE (0-24 MEAN, 25-49 STD); COLOURED = SELECTED",
+        "FEATURE (0-24 MEAN, 25-49 STD), COLOURED = SELECTED",
         1,
         INK,
     );

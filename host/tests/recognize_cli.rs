@@ -1,0 +1,218 @@
+//! The recognition commands end to end, as a user runs them: `synth` → `learn` →
+//! `train-effort` → `simulate`, plus the error a malformed log gives.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use figurine_host::events::read_events;
+
+fn figurine(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_figurine"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("figurine-recog-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn csvs(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .map(|p| p.display().to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn learn_then_simulate_a_sequence() {
+    let d = tmp("learn");
+    let lib = d.join("lib.json");
+    for action in ["jump", "spin"] {
+        let ex = d.join(action);
+        let out = figurine(&[
+            "synth",
+            "examples",
+            "--action",
+            action,
+            "--count",
+            "3",
+            "--seed",
+            "5",
+            "--out",
+            ex.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut args = vec![
+            "learn",
+            "--library",
+            lib.to_str().unwrap(),
+            "--name",
+            action,
+        ];
+        let files = csvs(&ex);
+        args.extend(files.iter().map(String::as_str));
+        let out = figurine(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let text = std::fs::read_to_string(&lib).unwrap();
+    for key in [
+        "\"name\": \"jump\"",
+        "\"regex\"",
+        "\"compiled\"",
+        "\"record_hex\"",
+        "\"blob_hex\"",
+    ] {
+        assert!(text.contains(key), "LIB.json lacks {key}");
+    }
+    // Learning the same examples under another name warns and names the other action.
+    let files = csvs(&d.join("jump"));
+    let mut args = vec!["learn", "--library", lib.to_str().unwrap(), "--name", "hop"];
+    args.extend(files.iter().map(String::as_str));
+    let out = figurine(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("warning") && err.contains("`jump`"), "{err}");
+
+    let log = d.join("seq.csv");
+    let labels = d.join("seq.json");
+    let out = figurine(&[
+        "synth",
+        "sequence",
+        "--seed",
+        "9",
+        "--count",
+        "4",
+        "--out",
+        log.to_str().unwrap(),
+        "--labels",
+        labels.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = figurine(&[
+        "simulate",
+        "--library",
+        lib.to_str().unwrap(),
+        "--jsonl",
+        log.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let events = read_events(&out.stdout[..], Path::new("stdout")).unwrap();
+    for e in &events {
+        assert!(
+            ["jump", "spin", "hop"].contains(&e.action.as_str()),
+            "{e:?}"
+        );
+        assert!((-1.0..=1.0).contains(&e.time) && (-1.0..=1.0).contains(&e.weight));
+        // Efforts are the device's i8 values / 127, bit for bit.
+        assert_eq!((e.time * 127.0).round() / 127.0, e.time);
+    }
+    // The table form works with the shipped library and effort model.
+    let out = figurine(&["simulate", log.to_str().unwrap()]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("samples accepted"));
+}
+
+#[test]
+fn train_effort_writes_model_and_report() {
+    let d = tmp("effort");
+    let set = d.join("set");
+    let out = figurine(&[
+        "synth",
+        "effort-set",
+        "--seed",
+        "3",
+        "--per-class",
+        "8",
+        "--out",
+        set.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let model = d.join("effort.json");
+    let out = figurine(&[
+        "train-effort",
+        "--out",
+        model.to_str().unwrap(),
+        set.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("Time:") && stdout.contains("Weight:"),
+        "{stdout}"
+    );
+    let png = image::open(d.join("effort.png")).unwrap();
+    assert!(png.width() > 500);
+    // The model loads into simulate.
+    let log = csvs(&set.join("sudden-strong")).remove(0);
+    let out = figurine(&[
+        "simulate",
+        "--effort",
+        model.to_str().unwrap(),
+        "--jsonl",
+        &log,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn malformed_logs_name_file_and_line() {
+    let d = tmp("bad");
+    let bad = d.join("bad.csv");
+    std::fs::write(
+        &bad,
+        "t,x,y,z,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.01,0,zz,0,1,0,0,0\n",
+    )
+    .unwrap();
+    let out = figurine(&["simulate", "--jsonl", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.csv:3"), "{err}");
+    // NaNs and time going backwards are counted and skipped, not errors.
+    let odd = d.join("odd.csv");
+    std::fs::write(
+        &odd,
+        "t,x,y,z,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.01,NaN,0,0,1,0,0,0\n0.005,0,0,0,1,0,0,0\n0.02,0,0,0,0,0,0,0\n",
+    )
+    .unwrap();
+    let out = figurine(&["simulate", odd.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
