@@ -2,9 +2,13 @@
 //!
 //! Modules are named after their stage in the data flow (see DESIGN.md).
 
+pub mod anim;
 pub mod data;
 pub mod events;
+pub mod graph;
 pub mod link;
+pub mod motion;
 pub mod poselog;
 pub mod recognize;
+pub mod render;
 pub mod synth;

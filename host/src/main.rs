@@ -1,6 +1,7 @@
-//! The `figurine` command-line tool.
+//! The `figurine` command-line tool: a thin dispatcher; each subcommand lives in its module.
 
 use clap::{Parser, Subcommand};
+use figurine_host::{anim, graph, link, recognize, render, synth};
 
 /// figurine: play with a toy, get a character animation.
 #[derive(Parser, Debug)]
@@ -10,49 +11,66 @@ struct Cli {
     command: Command,
 }
 
-/// Subcommands; each lives in its own module of the library.
+/// Subcommands, in data-flow order.
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
+    Synth(synth::cli::SynthArgs),
+    /// Print the motion-token runs of a pose log (what patterns are written in).
+    Tokens(recognize::tokens::TokensArgs),
+    /// Learn (or replace) an action's pattern from example pose logs.
+    Learn(recognize::learn::LearnArgs),
+    /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
+    TrainEffort(recognize::effort_train::TrainEffortArgs),
+    /// Run the recognizer on a pose log and print the recognised actions.
+    Simulate(recognize::simulate::SimulateArgs),
+    /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9).
+    Eval(recognize::eval::EvalArgs),
+    /// List serial ports (and, with --probe, the figurines on them).
+    Devices(link::cli::DevicesArgs),
+    /// Store an action library and effort model on figurines (kept across power cuts).
+    Upload(link::cli::UploadArgs),
+    /// Run a pose log through a figurine; prints events like `simulate --jsonl`.
+    Replay(link::cli::ReplayArgs),
+    /// Stream poses to figurines live, print events as they arrive, record the session.
+    Live(link::live::LiveArgs),
+    /// Assemble a character animation (BVH, optional .glb) from actions and the doodle.
+    Animate(anim::cli::AnimateArgs),
+    /// Inspect motion clips (`clip stages CLIP`).
+    Clip(anim::cli::ClipArgs),
+    /// Style-coherent motion graphs: build, synth, eval (seed 003).
+    Graph(graph::cli::GraphArgs),
+    /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
+    Render(render::cli::RenderArgs),
+    /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
+    View(render::cli::ViewArgs),
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
-    /// Learn (or replace) an action's pattern from example pose logs.
-    Learn(figurine_host::recognize::learn::LearnArgs),
-    /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
-    TrainEffort(figurine_host::recognize::effort_train::TrainEffortArgs),
-    /// Run the recognizer on a pose log and print the recognised actions.
-    Simulate(figurine_host::recognize::simulate::SimulateArgs),
-    /// Print the motion-token runs of a pose log (what patterns are written in).
-    Tokens(figurine_host::recognize::tokens::TokensArgs),
-    /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9).
-    Eval(figurine_host::recognize::eval::EvalArgs),
-    /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
-    Synth(figurine_host::synth::cli::SynthArgs),
-    /// List serial ports (and, with --probe, the figurines on them).
-    Devices(figurine_host::link::cli::DevicesArgs),
-    /// Store an action library and effort model on figurines (kept across power cuts).
-    Upload(figurine_host::link::cli::UploadArgs),
-    /// Run a pose log through a figurine; prints events like `simulate --jsonl`.
-    Replay(figurine_host::link::cli::ReplayArgs),
-    /// Stream poses to figurines live, print events as they arrive, record the session.
-    Live(figurine_host::link::live::LiveArgs),
 }
 
 fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
-    match cli.command {
+    match Cli::parse().command {
+        Command::Synth(a) => synth::cli::run(a)?,
+        Command::Tokens(a) => recognize::tokens::run(&a)?,
+        Command::Learn(a) => recognize::learn::run(&a)?,
+        Command::TrainEffort(a) => recognize::effort_train::run(&a)?,
+        Command::Simulate(a) => recognize::simulate::run(&a)?,
+        Command::Eval(a) => recognize::eval::run(&a)?,
+        Command::Devices(a) => link::cli::devices(&a)?,
+        Command::Upload(a) => link::cli::upload(&a)?,
+        Command::Replay(a) => link::cli::replay(&a)?,
+        Command::Live(a) => link::live::live(&a)?,
+        Command::Animate(a) => anim::cli::run_animate(&a)?,
+        Command::Clip(a) => anim::cli::run_clip(&a)?,
+        Command::Graph(a) => graph::cli::run(a)?,
+        Command::Render(a) => render::cli::run_render(&a)?,
+        Command::View(a) => render::cli::run_view(&a)?,
         Command::ProtocolVersion => {
-            println!("figurine-host {}", env!("CARGO_PKG_VERSION"));
+            println!(
+                "figurine protocol version {}",
+                figurine_protocol::PROTOCOL_VERSION
+            );
         }
-        Command::Learn(a) => figurine_host::recognize::learn::run(&a)?,
-        Command::TrainEffort(a) => figurine_host::recognize::effort_train::run(&a)?,
-        Command::Simulate(a) => figurine_host::recognize::simulate::run(&a)?,
-        Command::Tokens(a) => figurine_host::recognize::tokens::run(&a)?,
-        Command::Eval(a) => figurine_host::recognize::eval::run(&a)?,
-        Command::Synth(args) => figurine_host::synth::cli::run(args)?,
-        Command::Devices(a) => figurine_host::link::cli::devices(&a)?,
-        Command::Upload(a) => figurine_host::link::cli::upload(&a)?,
-        Command::Replay(a) => figurine_host::link::cli::replay(&a)?,
-        Command::Live(a) => figurine_host::link::live::live(&a)?,
     }
     Ok(())
 }

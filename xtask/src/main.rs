@@ -1,2 +1,58 @@
-//! `cargo xtask`: figurine's build automation (work in progress in this commit).
-fn main() {}
+//! `cargo xtask`: figurine's build automation.
+//!
+//! * `setup` — installs what a fresh Debian machine needs (idempotent).
+//! * `test` — setup, then every check: fmt, clippy, host tests, no_std checks for the thumb
+//!   target, firmware builds for every board, end-to-end tests.
+//! * `firmware --board qemu|nrf52840` — builds the firmware binary.
+//! * `fuzz --seconds N` — runs every cargo-fuzz target for N seconds (nightly).
+
+mod data;
+mod setup;
+mod tasks;
+mod util;
+
+use clap::{Parser, Subcommand};
+
+/// figurine's build automation.
+#[derive(Parser)]
+#[command(name = "cargo xtask")]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Install the Rust target, Debian packages, validators and real data (idempotent).
+    Setup,
+    /// Fetch only the real motion data into target/figurine-data.
+    Data,
+    /// Run every check and test (calls setup first).
+    Test,
+    /// Build the firmware for a board.
+    Firmware {
+        /// Which board: `qemu` (mps2-an386) or `nrf52840`.
+        #[arg(long, default_value = "qemu")]
+        board: tasks::Board,
+        /// Build with the dev profile instead of release.
+        #[arg(long)]
+        debug: bool,
+    },
+    /// Run each fuzz target for a while (needs the nightly toolchain; installs cargo-fuzz).
+    Fuzz {
+        /// Seconds per target.
+        #[arg(long, default_value_t = 20)]
+        seconds: u64,
+    },
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Cmd::Setup => setup::setup(),
+        Cmd::Data => data::fetch(),
+        Cmd::Test => tasks::test(),
+        Cmd::Firmware { board, debug } => tasks::firmware(board, !debug),
+        Cmd::Fuzz { seconds } => tasks::fuzz(seconds),
+    }
+}

@@ -11,6 +11,12 @@ use super::knobs::{Knobs, Range};
 use super::sampling::SignMode;
 use super::sequence::{effort_set, examples, gesture, sequence, Doodle};
 
+/// Most actions in one `sequence` log (≈ 2–3 s each; 10 000 actions at 240 Hz ≈ 6 M samples,
+/// ≈ 400 MB in memory).
+pub const MAX_SEQUENCE_ACTIONS: usize = 10_000;
+/// Most logs per effort state in `effort-set`, and most `examples`.
+pub const MAX_SET_SIZE: usize = 100_000;
+
 /// Generate synthetic spatial motion doodles (seeded, labelled pose logs).
 #[derive(Args, Debug)]
 pub struct SynthArgs {
@@ -96,12 +102,19 @@ enum SynthCommand {
         #[command(flatten)]
         knobs: KnobArgs,
     },
-    /// One performance of every action (in the order walk, run, jump, punch, throw, kick,
-    /// turn, sidestep, crouch, bow, wave, spin), plotted small on a 4×3 grid.
+    /// A picture of every action, or of one action in the four effort states.
+    ///
+    /// Without `--action`: one performance of every action (walk, run, jump, punch, throw,
+    /// kick, turn, sidestep, crouch, bow, wave, spin) plotted small on a 4×3 grid. With
+    /// `--action`: that action in the four effort states (same seed, so only the effort
+    /// differs), 2×2.
     Gallery {
         /// Master seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Compare the four effort states of this action instead.
+        #[arg(long)]
+        action: Option<Action>,
         /// Effort of every performance (default: a random state each).
         #[arg(long, default_value = "random")]
         effort: EffortArg,
@@ -184,7 +197,11 @@ struct KnobArgs {
     /// Quaternion sign convention: continuous, canonical, flips [default: random per doodle].
     #[arg(long)]
     quat_sign: Option<SignMode>,
-    /// A perfect tracker: no noise, tremor, drift, jitter or drops (overrides those knobs).
+    /// Probability per sample of a tracker glitch: spike, NaN row, zero quaternion, repeated or
+    /// backward timestamp [default: 0].
+    #[arg(long)]
+    glitch: Option<Range>,
+    /// A perfect tracker: no noise, tremor, drift, jitter, drops or glitches (overrides those).
     #[arg(long)]
     clean: bool,
 }
@@ -207,11 +224,13 @@ impl KnobArgs {
             lead_s: self.lead.unwrap_or(d.lead_s),
             pause_s: self.pause.unwrap_or(d.pause_s),
             sign: self.quat_sign,
+            glitch: self.glitch.unwrap_or(d.glitch),
         };
         if self.clean {
             k.noise = Range::fixed(0.0);
             k.jitter = Range::fixed(0.0);
             k.drop = Range::fixed(0.0);
+            k.glitch = Range::fixed(0.0);
         }
         k.validate().map_err(anyhow::Error::msg)?;
         Ok(k)
@@ -226,23 +245,40 @@ fn write_doodle(d: &Doodle, out: &Path) -> Result<()> {
         .with_context(|| format!("writing {}", out.display()))
 }
 
+/// Labels listed in full by the summary; longer sequences are elided.
+const SUMMARY_LABELS: usize = 24;
+
+/// Prints what was written. Write errors (e.g. a closed pipe) are ignored: the files are done.
 fn summary(d: &Doodle, out: &Path) {
+    use std::io::Write;
+    let mut w = std::io::stdout().lock();
     let n = d.log.samples.len();
     let (t0, t1) = match (d.log.samples.first(), d.log.samples.last()) {
         (Some(a), Some(b)) => (a.t, b.t),
         _ => (0.0, 0.0),
     };
-    println!(
+    let _ = writeln!(
+        w,
         "{}: {n} samples, {t0:.3}..{t1:.3} s, {}",
         out.display(),
         d.variation
     );
-    for l in &d.labels {
-        println!(
+    for l in d.labels.iter().take(SUMMARY_LABELS) {
+        let _ = writeln!(
+            w,
             "  {:<9} {:>9.3} .. {:>9.3} s  {:?}/{:?}",
             l.action, l.start, l.end, l.time_class, l.weight_class
         );
     }
+    if d.labels.len() > SUMMARY_LABELS {
+        let _ = writeln!(w, "  … {} more", d.labels.len() - SUMMARY_LABELS);
+    }
+}
+
+/// Prints one line, ignoring a closed pipe.
+fn say(line: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout().lock(), "{line}");
 }
 
 /// Runs `figurine synth …`.
@@ -276,8 +312,8 @@ pub fn run(args: SynthArgs) -> Result<()> {
             labels,
             knobs,
         } => {
-            if count == 0 {
-                bail!("--count must be at least 1");
+            if count == 0 || count > MAX_SEQUENCE_ACTIONS {
+                bail!("--count {count}: must be within 1..={MAX_SEQUENCE_ACTIONS}");
             }
             let knobs = knobs.knobs()?;
             let d = sequence(seed, &knobs, count, effort.0);
@@ -292,6 +328,9 @@ pub fn run(args: SynthArgs) -> Result<()> {
             out,
             knobs,
         } => {
+            if per_class == 0 || per_class > MAX_SET_SIZE {
+                bail!("--per-class {per_class}: must be within 1..={MAX_SET_SIZE}");
+            }
             let knobs = knobs.knobs()?;
             let set = effort_set(seed, &knobs, per_class);
             let mut index = Vec::with_capacity(set.len());
@@ -312,13 +351,13 @@ pub fn run(args: SynthArgs) -> Result<()> {
             let idx = out.join("labels.json");
             std::fs::write(&idx, serde_json::to_string_pretty(&index)? + "\n")
                 .with_context(|| format!("writing {}", idx.display()))?;
-            println!(
+            say(format_args!(
                 "{}: {} logs in {} effort folders (index: {})",
                 out.display(),
                 set.len(),
                 Effort::STATES.len(),
                 idx.display()
-            );
+            ));
         }
         SynthCommand::Examples {
             action,
@@ -328,6 +367,9 @@ pub fn run(args: SynthArgs) -> Result<()> {
             out,
             knobs,
         } => {
+            if count == 0 || count > MAX_SET_SIZE {
+                bail!("--count {count}: must be within 1..={MAX_SET_SIZE}");
+            }
             let knobs = knobs.knobs()?;
             for (i, d) in examples(seed, &knobs, action, count, effort.0)
                 .iter()
@@ -340,31 +382,44 @@ pub fn run(args: SynthArgs) -> Result<()> {
         }
         SynthCommand::Gallery {
             seed,
+            action,
             effort,
             out,
             knobs,
         } => {
             let knobs = knobs.knobs()?;
-            let pics: Vec<_> = Action::ALL
-                .iter()
-                .enumerate()
-                .map(|(i, &a)| {
-                    let s = super::sequence::item_seed(seed, i as u64);
-                    let e = effort
-                        .0
-                        .unwrap_or_else(|| super::sequence::random_state_for(s));
-                    let d = gesture(s, &knobs, a, e);
-                    super::plot::plot(&d.log, &d.labels)
-                })
-                .collect();
-            super::plot::gallery(&pics, 4)
+            let tile = |s: u64, a: Action, e: Effort| {
+                let d = gesture(s, &knobs, a, e);
+                (super::plot::plot(&d.log, &d.labels), format!("{a} {e}"))
+            };
+            let (pics, cols): (Vec<_>, u32) = match action {
+                Some(a) => (
+                    Effort::STATES.iter().map(|&e| tile(seed, a, e)).collect(),
+                    2,
+                ),
+                None => (
+                    Action::ALL
+                        .iter()
+                        .enumerate()
+                        .map(|(i, &a)| {
+                            let s = super::sequence::item_seed(seed, i as u64);
+                            let e = effort
+                                .0
+                                .unwrap_or_else(|| super::sequence::random_state_for(s));
+                            tile(s, a, e)
+                        })
+                        .collect(),
+                    4,
+                ),
+            };
+            super::plot::gallery(&pics, cols)
                 .save(&out)
                 .with_context(|| format!("writing {}", out.display()))?;
-            println!("{}", out.display());
+            say(format_args!("{}", out.display()));
         }
         SynthCommand::Plot { log, labels, out } => {
             super::plot::plot_files(&log, labels.as_deref(), &out)?;
-            println!("{}", out.display());
+            say(format_args!("{}", out.display()));
         }
     }
     Ok(())

@@ -5,17 +5,18 @@
 //! gesture, e.g. one hop or one thrust):
 //!
 //! * **Time** sets the stroke's duration and its *onset*. Sudden strokes are short
-//!   (×0.42–0.7 of the neutral duration) and start explosively (the velocity profile rises
+//!   (×0.45–0.7 of the neutral duration) and start explosively (the velocity profile rises
 //!   almost at once); sustained strokes are long (×1.5–2.4) and ease in gently.
 //! * **Weight** sets the stroke's amplitude and its *ending*. Strong strokes are bigger
-//!   (×1.15–1.45), arrive with speed and stop abruptly with a short recoil (impact), so their
+//!   (×1.15–1.45), arrive with speed and stop in an impact (a damped overshoot), so their
 //!   accelerations are large and concentrated; light strokes are smaller (×0.6–0.85) and fade out
 //!   delicately, with small, evenly spread accelerations. Following the Effort–Shape affinities
 //!   of seed 000 §5.1, strong hops are also relatively flatter (sinking) and light ones higher
 //!   (rising).
 //!
 //! The velocity profile of a stroke is a Beta-shaped bump `v(τ) ∝ τ^a (1−τ)^b` over normalised
-//! time τ ∈ [0, 1]: `a` (onset) comes from Time, `b` (ending) from Weight. Its integral, the
+//! time τ ∈ [0, 1]: `a` (onset, 1–1.4 sudden, 1.9–2.9 sustained) comes from Time, `b` (ending,
+//! 1–1.5 strong, 2.2–3.4 light) and the impact cut (strong only) from Weight. Its integral, the
 //! progress `s(τ)` from 0 to 1, drives every displacement and rotation of the stroke. The
 //! classic combinations come out as Laban's drives: sudden+strong ≈ punch, sudden+light ≈ flick,
 //! sustained+strong ≈ press, sustained+light ≈ glide/float.
@@ -101,15 +102,21 @@ impl Effort {
         let lift = rng.unit();
         let lerp = |lo: f64, hi: f64, u: f64| lo + (hi - lo) * u;
         let (time_factor, a) = match self.time {
-            TimeClass::Sudden => (lerp(0.42, 0.7, tf), lerp(0.45, 0.9, onset)),
-            TimeClass::Sustained => (lerp(1.5, 2.4, tf), lerp(1.7, 2.8, onset)),
-            TimeClass::Neutral => (lerp(0.85, 1.2, tf), lerp(1.2, 1.9, onset)),
+            TimeClass::Sudden => (lerp(0.45, 0.7, tf), lerp(1.0, 1.4, onset)),
+            TimeClass::Sustained => (lerp(1.5, 2.4, tf), lerp(1.9, 2.9, onset)),
+            TimeClass::Neutral => (lerp(0.85, 1.2, tf), lerp(1.4, 1.9, onset)),
         };
-        let (amplitude, b, ring_amp, lift) = match self.weight {
+        let (amplitude, b, impact, lift) = match self.weight {
             WeightClass::Strong => (
                 lerp(1.15, 1.45, amp),
-                lerp(0.55, 1.0, ending),
-                lerp(0.06, 0.12, ring),
+                lerp(1.0, 1.5, ending),
+                // A sudden strong stroke hits (arrives at full speed); a sustained one presses
+                // on and stops firmly.
+                if self.time == TimeClass::Sustained {
+                    lerp(0.1, 0.2, ring)
+                } else {
+                    lerp(0.25, 0.4, ring)
+                },
                 lerp(0.8, 0.95, lift),
             ),
             WeightClass::Light => (
@@ -118,13 +125,13 @@ impl Effort {
                 0.0,
                 lerp(1.1, 1.3, lift),
             ),
-            WeightClass::Neutral => (lerp(0.9, 1.1, amp), lerp(1.2, 1.9, ending), 0.0, 1.0),
+            WeightClass::Neutral => (lerp(0.9, 1.1, amp), lerp(1.4, 1.9, ending), 0.0, 1.0),
         };
         EffortShape {
             time_factor,
             amplitude,
             lift,
-            profile: Profile::new(a, b, ring_amp),
+            profile: Profile::new(a, b, impact),
         }
     }
 }
@@ -197,82 +204,156 @@ pub struct EffortShape {
     pub profile: Profile,
 }
 
+/// Added to the ending exponent of recovery strokes.
+pub const RECOVERY_EASE: f64 = 0.8;
+
 /// Number of points of the tabulated progress curve of a [`Profile`].
 const PROFILE_TABLE: usize = 257;
 
-/// Fraction of a ringing stroke spent in the post-impact recoil.
-const RING_FRACTION: f64 = 0.22;
+/// Time an impact takes to settle, seconds: a hand stopping a toy hard decelerates within
+/// ~20 ms (the first quarter cycle) and the bounce dies out in ~0.1 s, however long the stroke.
+pub const IMPACT_SETTLE_S: f64 = 0.1;
+/// Bounds of the settle's share of a stroke (very short or very long strokes).
+const SETTLE_FRACTION_RANGE: (f64, f64) = (0.05, 0.5);
 
-/// A stroke's velocity profile: Beta bump `τ^a (1−τ)^b`, optionally followed by a damped
-/// recoil around the end point (strong impacts).
+/// Share of a stroke of `duration_s` seconds spent settling after an impact.
+fn settle_fraction(duration_s: f64) -> f64 {
+    if duration_s.is_finite() && duration_s > 0.0 {
+        (IMPACT_SETTLE_S / duration_s).clamp(SETTLE_FRACTION_RANGE.0, SETTLE_FRACTION_RANGE.1)
+    } else {
+        SETTLE_FRACTION_RANGE.1
+    }
+}
+/// Damped cycles of the settle (per settle phase).
+const SETTLE_CYCLES: f64 = 1.25;
+/// Exponential decay of the settle over its phase (e^-5 ≈ 0.7 % left).
+const SETTLE_DECAY: f64 = 5.0;
+
+/// A stroke's velocity profile: a Beta bump `τ^a (1−τ)^b`, optionally cut short by an impact.
+///
+/// With `impact` > 0 the bump is cut at `1 − impact` of its course and stretched to reach the
+/// end point there, so the figurine arrives with speed and stops in a short damped bounce about
+/// the end point lasting [`IMPACT_SETTLE_S`] whatever the stroke's length (position and velocity continuous; the deceleration is large but finite, so
+/// sampled accelerations do not grow without bound with the sample rate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Profile {
-    /// Onset exponent (small = explosive start).
+    /// Onset exponent (near 1 = the velocity rises at once; larger = gentle start).
     pub a: f64,
-    /// Ending exponent (small = abrupt stop).
+    /// Ending exponent (near 1 = brisk stop; larger = delicate fade).
     pub b: f64,
-    /// Recoil amplitude as a fraction of the stroke (0 = none).
-    pub ring: f64,
+    /// Fraction of the bump cut off by an impact, in [0, 0.6] (0 = none).
+    pub impact: f64,
     table: [f64; PROFILE_TABLE],
+    /// ∫₀¹ τ^a (1−τ)^b dτ (numerical).
+    norm: f64,
 }
 
 impl Profile {
-    /// A profile with onset `a`, ending `b` (both clamped to [0.3, 6]) and recoil `ring`.
-    pub fn new(a: f64, b: f64, ring: f64) -> Self {
-        let a = a.clamp(0.3, 6.0);
-        let b = b.clamp(0.3, 6.0);
+    /// A profile with onset `a`, ending `b` (both clamped to [1, 6]: no infinite
+    /// accelerations) and `impact` (clamped to [0, 0.6]).
+    pub fn new(a: f64, b: f64, impact: f64) -> Self {
+        let a = if a.is_finite() {
+            a.clamp(1.0, 6.0)
+        } else {
+            2.0
+        };
+        let b = if b.is_finite() {
+            b.clamp(1.0, 6.0)
+        } else {
+            2.0
+        };
+        let impact = if impact.is_finite() {
+            impact.clamp(0.0, 0.6)
+        } else {
+            0.0
+        };
         let mut table = [0.0; PROFILE_TABLE];
         // Cumulative midpoint integration of the Beta kernel, normalised to end at 1.
         let n = PROFILE_TABLE - 1;
         let mut acc = 0.0;
         for (i, slot) in table.iter_mut().enumerate().skip(1) {
             let tau = (i as f64 - 0.5) / n as f64;
-            acc += tau.powf(a) * (1.0 - tau).powf(b);
+            acc += kernel(a, b, tau);
             *slot = acc;
         }
-        if acc > 0.0 {
-            for v in &mut table {
-                *v /= acc;
-            }
+        for v in &mut table {
+            *v /= acc;
         }
         Self {
             a,
             b,
-            ring: ring.max(0.0),
+            impact,
             table,
+            norm: acc / n as f64,
         }
     }
 
-    /// Minimum-jerk-like symmetric profile (a = b = 2), no recoil.
+    /// Minimum-jerk-like symmetric profile (a = b = 2), no impact.
     pub fn smooth() -> Self {
         Self::new(2.0, 2.0, 0.0)
     }
 
-    /// Progress in [0, 1] (slightly beyond 1 during a recoil) at normalised time `tau`.
-    pub fn progress(&self, tau: f64) -> f64 {
+    /// The same onset and ending without the impact.
+    pub fn without_impact(&self) -> Self {
+        Self::new(self.a, self.b, 0.0)
+    }
+
+    /// The profile of a recovery stroke (wind-up, return): same onset, no impact, and an
+    /// ending eased by [`RECOVERY_EASE`] — the emphasis of a gesture is in its main strokes.
+    pub fn recovery(&self) -> Self {
+        Self::new(self.a, self.b + RECOVERY_EASE, 0.0)
+    }
+
+    /// Normalised integral of the kernel from 0 to `x`: cubic Hermite interpolation of the
+    /// table with the exact kernel as slope, so velocity is continuous between table points
+    /// (linear interpolation would put acceleration spikes at every table point).
+    fn cumulative(&self, x: f64) -> f64 {
+        let n = (PROFILE_TABLE - 1) as f64;
+        let x = x.clamp(0.0, 1.0) * n;
+        let i = (x.floor() as usize).min(PROFILE_TABLE - 2);
+        let f = x - i as f64;
+        let slope = |k: usize| kernel(self.a, self.b, k as f64 / n) / self.norm / n;
+        let (p0, p1) = (self.table[i], self.table[i + 1]);
+        let (m0, m1) = (slope(i), slope(i + 1));
+        let (f2, f3) = (f * f, f * f * f);
+        (2.0 * f3 - 3.0 * f2 + 1.0) * p0
+            + (f3 - 2.0 * f2 + f) * m0
+            + (-2.0 * f3 + 3.0 * f2) * p1
+            + (f3 - f2) * m1
+    }
+
+    /// Progress in [0, 1] (beyond 1 during an impact's overshoot) at normalised time `tau` of
+    /// a stroke lasting `duration_s` seconds (which sets how much of it the impact's settle
+    /// takes).
+    pub fn progress(&self, tau: f64, duration_s: f64) -> f64 {
         let tau = if tau.is_finite() {
             tau.clamp(0.0, 1.0)
         } else {
             0.0
         };
-        let main = if self.ring > 0.0 {
-            1.0 - RING_FRACTION
-        } else {
-            1.0
-        };
-        if tau >= main {
-            if self.ring <= 0.0 {
-                return 1.0;
-            }
-            let u = (tau - main) / RING_FRACTION;
-            // Overshoot forward, swing back, settle: 1.5 damped cycles.
-            return 1.0 + self.ring * (-4.0 * u).exp() * (std::f64::consts::TAU * 1.5 * u).sin();
+        if self.impact <= 0.0 {
+            return self.cumulative(tau);
         }
-        let x = tau / main * (PROFILE_TABLE - 1) as f64;
-        let i = (x.floor() as usize).min(PROFILE_TABLE - 2);
-        let f = x - i as f64;
-        self.table[i] * (1.0 - f) + self.table[i + 1] * f
+        let settle = settle_fraction(duration_s);
+        let main = 1.0 - settle;
+        let cut = 1.0 - self.impact;
+        let reach = self.cumulative(cut).max(1e-9);
+        if tau < main {
+            return self.cumulative(tau / main * cut) / reach;
+        }
+        // Arrive at the end point with speed v0, then a damped bounce about it, in settle
+        // time u ∈ [0, 1] (x(0) = 1, x'(0) = v0).
+        let v0 = kernel(self.a, self.b, cut) / self.norm * cut / main / reach * settle;
+        let u = (tau - main) / settle;
+        let w = std::f64::consts::TAU * SETTLE_CYCLES;
+        let spring = |u: f64| (-SETTLE_DECAY * u).exp() * (v0 / w) * (w * u).sin();
+        // Remove the tiny residual at u = 1 with a blend that keeps the start untouched.
+        1.0 + spring(u) - spring(1.0) * u * u * (3.0 - 2.0 * u)
     }
+}
+
+fn kernel(a: f64, b: f64, tau: f64) -> f64 {
+    tau.powf(a) * (1.0 - tau).powf(b)
 }
 
 #[cfg(test)]
@@ -295,19 +376,35 @@ mod tests {
             let p = Profile::new(a, b, 0.0);
             let mut last = -1.0;
             for i in 0..=100 {
-                let s = p.progress(i as f64 / 100.0);
+                let s = p.progress(i as f64 / 100.0, 0.5);
                 assert!(s >= last - 1e-12);
                 last = s;
             }
-            assert!(p.progress(0.0).abs() < 1e-12);
-            assert!((p.progress(1.0) - 1.0).abs() < 1e-12);
+            assert!(p.progress(0.0, 0.5).abs() < 1e-12);
+            assert!((p.progress(1.0, 0.5) - 1.0).abs() < 1e-12);
         }
-        let ringing = Profile::new(1.0, 1.0, 0.1);
-        let peak = (0..=100)
-            .map(|i| ringing.progress(i as f64 / 100.0))
+        let hit = Profile::new(1.2, 1.2, 0.25);
+        let pts: Vec<f64> = (0..=1000)
+            .map(|i| hit.progress(i as f64 / 1000.0, 0.5))
+            .collect();
+        let peak = pts.iter().cloned().fold(0.0, f64::max);
+        assert!(peak > 1.001 && peak < 1.05, "{peak}");
+        assert!((hit.progress(1.0, 0.5) - 1.0).abs() < 1e-12);
+        // Continuous: no step larger than the fastest motion allows.
+        let worst = pts
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
             .fold(0.0, f64::max);
-        assert!(peak > 1.02 && peak < 1.1, "{peak}");
-        assert!((ringing.progress(1.0) - 1.0).abs() < 0.01);
+        assert!(worst < 0.01, "{worst}");
+        // Velocity continuous across the impact (within the discretisation).
+        let m = 1.0 - settle_fraction(0.5);
+        let h = 1e-5;
+        let before = (hit.progress(m - h, 0.5) - hit.progress(m - 2.0 * h, 0.5)) / h;
+        let after = (hit.progress(m + 2.0 * h, 0.5) - hit.progress(m + h, 0.5)) / h;
+        assert!(
+            (before - after).abs() < 0.05 * before.abs(),
+            "{before} vs {after}"
+        );
     }
 
     #[test]
@@ -316,6 +413,6 @@ mod tests {
         let sudden = Effort::STATES[0].shape(&mut rng);
         let sustained = Effort::STATES[2].shape(&mut rng);
         assert!(sudden.time_factor < sustained.time_factor);
-        assert!(sudden.profile.progress(0.2) > sustained.profile.progress(0.2));
+        assert!(sudden.profile.progress(0.2, 0.3) > sustained.profile.progress(0.2, 1.0));
     }
 }

@@ -108,6 +108,9 @@ impl FromStr for Action {
     }
 }
 
+/// How stroke durations grow with the doodle's scale: duration ∝ scale^0.4.
+pub const DURATION_SCALE_EXPONENT: f64 = 0.4;
+
 /// Draws sizes and timings for one performance.
 struct Draw<'a> {
     rng: &'a mut SynthRng,
@@ -116,9 +119,13 @@ struct Draw<'a> {
 }
 
 impl Draw<'_> {
-    /// A stroke duration in seconds from a neutral range.
+    /// A stroke duration in seconds from a neutral range. Bigger doodles take somewhat longer
+    /// (× scale^[`DURATION_SCALE_EXPONENT`]), as bigger arm movements do, so speed grows less
+    /// than linearly with scale.
     fn dur(&mut self, lo: f64, hi: f64) -> f64 {
-        self.rng.uniform(lo, hi) * self.shape.time_factor
+        self.rng.uniform(lo, hi)
+            * self.shape.time_factor
+            * self.scale.max(1e-3).powf(DURATION_SCALE_EXPONENT)
     }
 
     /// A hold duration: effort stretches holds less than strokes.
@@ -149,17 +156,16 @@ impl Draw<'_> {
         DVec3::new(r * a.cos(), 0.0, r * a.sin())
     }
 
-    /// A main stroke (with the effort's impact recoil, if any).
+    /// A main stroke (with the effort's impact, if any).
     fn stroke(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
         Stroke::moving(d, self.shape.profile)
     }
 
-    /// A recovery stroke (same onset and ending, no recoil).
+    /// A recovery stroke (wind-up, return): same onset, eased ending, no impact.
     fn recover(&mut self, lo: f64, hi: f64) -> Stroke {
         let d = self.dur(lo, hi);
-        let p = self.shape.profile;
-        Stroke::moving(d, super::effort::Profile::new(p.a, p.b, 0.0))
+        Stroke::moving(d, self.shape.profile.recovery())
     }
 }
 
@@ -195,7 +201,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             let rock = d.ang(3.0, 6.0);
             let side = d.rng.sign();
             for i in 0..n {
-                let mut s = d.stroke(0.18, 0.26);
+                let mut s = d.stroke(0.2, 0.28);
                 s.translate.z = d.len(0.12, 0.2);
                 s.arc.y = d.len(0.012, 0.025);
                 let alt = if i % 2 == 0 { 1.0 } else { -1.0 };
@@ -243,7 +249,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             }
             let reach = d.len(0.1, 0.2);
             let twist = d.ang(0.0, 15.0) * d.rng.sign();
-            let mut thrust = d.stroke(0.12, 0.22);
+            let mut thrust = d.stroke(0.22, 0.34);
             thrust.translate.z = windup + reach;
             thrust.rotate.z = twist;
             out.push(thrust);
@@ -264,7 +270,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             let fz = d.len(0.15, 0.25);
             let fy = d.len(0.0, 0.04);
             let pf = d.ang(15.0, 30.0);
-            let mut release = d.stroke(0.22, 0.32);
+            let mut release = d.stroke(0.28, 0.4);
             release.translate = DVec3::new(0.0, fy, bz + fz);
             release.arc.y = d.len(0.03, 0.06);
             release.rotate.x = pb + pf;
@@ -289,7 +295,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             let fz = d.len(0.05, 0.1);
             let fy = d.len(0.03, 0.07);
             let lean = d.ang(15.0, 30.0);
-            let mut flick = d.stroke(0.18, 0.28);
+            let mut flick = d.stroke(0.22, 0.34);
             flick.translate = DVec3::new(0.0, fy, prep + fz);
             flick.rotate.x = -lean;
             out.push(flick);
@@ -371,7 +377,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             let mut roll = 0.0_f64;
             for target in targets {
                 let target = target * d.rng.uniform(0.85, 1.15);
-                let mut s = d.stroke(0.14, 0.28);
+                let mut s = d.stroke(0.18, 0.3);
                 s.rotate.z = target - roll;
                 s.pivot = feet;
                 out.push(s);

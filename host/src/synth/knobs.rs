@@ -108,6 +108,9 @@ pub struct Knobs {
     pub pause_s: Range,
     /// Quaternion sign convention; `None` draws one per doodle.
     pub sign: Option<SignMode>,
+    /// Probability per sample of a tracker glitch (spike, NaN row, zero quaternion, repeated or
+    /// backward timestamp); default 0 (see [`super::noise::Glitcher`]).
+    pub glitch: Range,
 }
 
 impl Default for Knobs {
@@ -127,6 +130,7 @@ impl Default for Knobs {
             lead_s: Range::new(0.4, 1.2),
             pause_s: Range::new(0.3, 1.5),
             sign: None,
+            glitch: Range::fixed(0.0),
         }
     }
 }
@@ -150,6 +154,7 @@ impl Knobs {
             lead_s: Range::fixed(0.5),
             pause_s: Range::fixed(0.5),
             sign: Some(SignMode::Continuous),
+            glitch: Range::fixed(0.0),
         }
     }
 
@@ -169,6 +174,7 @@ impl Knobs {
         let noise = self.noise.draw(rng);
         let t0 = self.t0.draw(rng);
         let sign_pick = rng.index(SignMode::ALL.len());
+        let glitch = self.glitch.draw(rng);
         // Tilt about a horizontal axis of the object (a mix of pitch and roll).
         let axis = DVec3::new(tilt_dir.cos(), 0.0, tilt_dir.sin());
         Variation {
@@ -183,6 +189,7 @@ impl Knobs {
             noise,
             t0,
             sign: self.sign.unwrap_or(SignMode::ALL[sign_pick]),
+            glitch,
         }
     }
 
@@ -209,6 +216,7 @@ impl Knobs {
         check("t0", self.t0, -1e6, 1e6)?;
         check("lead", self.lead_s, 0.0, 60.0)?;
         check("pause", self.pause_s, 0.0, 60.0)?;
+        check("glitch", self.glitch, 0.0, 0.5)?;
         Ok(())
     }
 }
@@ -238,6 +246,8 @@ pub struct Variation {
     pub t0: f64,
     /// Quaternion sign convention.
     pub sign: SignMode,
+    /// Glitch probability per sample.
+    pub glitch: f64,
 }
 
 impl fmt::Display for Variation {
@@ -247,7 +257,7 @@ impl fmt::Display for Variation {
         write!(
             f,
             "rate={:.1}Hz jitter={:.3} drop={:.4} scale={:.3} speed={:.3} heading={:.1}deg \
-             tilt={:.1}deg start=({:.3},{:.3},{:.3}) noise={:.3} t0={:.3}s sign={}",
+             tilt={:.1}deg start=({:.3},{:.3},{:.3}) noise={:.3} t0={:.3}s sign={} glitch={:.4}",
             self.rate_hz,
             self.jitter,
             self.drop,
@@ -260,7 +270,8 @@ impl fmt::Display for Variation {
             self.start.z,
             self.noise,
             self.t0,
-            self.sign
+            self.sign,
+            self.glitch
         )
     }
 }

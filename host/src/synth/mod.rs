@@ -11,11 +11,19 @@
 //! seed and written with [`crate::poselog`].
 //!
 //! Data flow, one file per stage: [`rng`] (seeded streams) → [`knobs`] (nuisance draw) →
-//! [`effort`] + [`gesture`] (strokes) → [`trajectory`] (clean pose over time) → [`sampling`]
-//! (sample instants, quaternion sign) + [`noise`] (sensor and hand) → [`sequence`] (labelled
-//! doodles and sets) → [`cli`] / [`plot`].
+//! [`effort`] + [`mod@gesture`] (strokes) → [`trajectory`] (clean pose over time) → [`sampling`]
+//! (sample instants, quaternion sign) + [`noise`] (sensor, hand, optional glitches) →
+//! [`mod@sequence`] (labelled doodles and sets) → [`cli`] / [`plot`] (+ [`font`] for captions).
 //!
-//! Library use (in-process, no files):
+//! How the effort classes show in the data (what a recognizer can learn): Time in stroke
+//! durations (sustained ≈ 3× sudden) and peak speeds (≥ 1.9× at equal weight); Weight in
+//! amplitude (strong ≈ 1.7× light) and in how strokes end — strong strokes stop in a ~20 ms
+//! impact with a small bounce, light ones fade out — so peak deceleration over peak
+//! acceleration separates them without knowing the doodle's scale. Impacts need ≳ 60 Hz to be
+//! seen; at 30 Hz Weight shows mostly through amplitude and speed.
+//!
+//! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot` (see
+//! [`cli`]). Library use (in-process, no files):
 //! ```
 //! use figurine_host::synth::{gesture, Action, Effort, Knobs};
 //! let d = gesture(7, &Knobs::default(), Action::Jump, "sudden-strong".parse().unwrap());
@@ -25,6 +33,7 @@
 
 pub mod cli;
 pub mod effort;
+pub mod font;
 pub mod gesture;
 pub mod knobs;
 pub mod noise;
@@ -37,4 +46,4 @@ pub mod trajectory;
 pub use effort::{Effort, TimeClass, WeightClass};
 pub use gesture::Action;
 pub use knobs::{Knobs, Range, Variation};
-pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label};
+pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label, Performer};

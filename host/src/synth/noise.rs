@@ -5,10 +5,13 @@
 //! * **white sensor noise** per sample: position σ 0.1–1.5 mm, orientation σ 0.02–0.3°;
 //! * **hand tremor**: physiological 8–12 Hz oscillation, two partials per axis with a slow
 //!   (0.15–0.6 Hz) swell, position 0.2–1.2 mm, orientation 0.05–0.35° — present during pauses too;
-//! * **slow drift**: low-frequency (0.01–0.12 Hz) wander of 1–8 mm plus a linear creep up to
-//!   0.5 mm/s, and a heading (yaw) drift up to 0.3°/s, as IMU-assisted trackers show;
+//! * **slow drift**: low-frequency (0.005–0.12 Hz) wander of 1–8 mm in position and up to 3° in
+//!   heading (yaw), bounded however long the log, as IMU-assisted trackers show;
 //! * all three are continuous functions of time except the white noise, so a 30 Hz and a
-//!   240 Hz log of the same seed see the same tremor and drift.
+//!   240 Hz log of the same seed see the same tremor and drift;
+//! * optional **glitches** ([`Glitcher`], off by default): the faults a recognizer must count
+//!   and skip — a one-sample position spike, a NaN row, a zero quaternion, a repeated or a
+//!   backward timestamp.
 
 use std::f64::consts::TAU;
 
@@ -68,8 +71,7 @@ pub struct SensorModel {
     tremor_rot: [[Partial; TREMOR_PARTIALS]; 3],
     swell: Partial,
     drift_pos: [[Partial; DRIFT_PARTIALS]; 3],
-    creep: DVec3,
-    yaw_rate: f64,
+    yaw_drift: Partial,
     t0: f64,
 }
 
@@ -94,10 +96,12 @@ impl SensorModel {
             phase: rng.uniform(0.0, TAU),
         };
         let drift_amp = m * rng.uniform(1e-3, 8e-3);
-        let drift_pos = partials(rng, drift_amp, 0.01, 0.12);
-        let creep = DVec3::new(rng.normal(), rng.normal() * 0.3, rng.normal())
-            * (m * rng.uniform(0.0, 0.5e-3) / 1.4);
-        let yaw_rate = m * rng.uniform(-0.3, 0.3).to_radians();
+        let drift_pos = partials(rng, drift_amp, 0.005, 0.12);
+        let yaw_drift = Partial {
+            amp: m * rng.uniform(0.0, 3.0).to_radians(),
+            freq: rng.uniform(0.005, 0.05),
+            phase: rng.uniform(0.0, TAU),
+        };
         Self {
             pos_sigma,
             rot_sigma,
@@ -105,8 +109,7 @@ impl SensorModel {
             tremor_rot,
             swell,
             drift_pos,
-            creep,
-            yaw_rate,
+            yaw_drift,
             t0,
         }
     }
@@ -119,18 +122,77 @@ impl SensorModel {
     /// The measured pose at time `t` (seconds) of a true pose (`pos` metres, `q` object→world);
     /// `white` supplies the per-sample noise.
     pub fn measure(&self, t: f64, pos: DVec3, q: DQuat, white: &mut SynthRng) -> (DVec3, DQuat) {
-        let dt = t - self.t0;
         let swell = 1.0 + self.swell.at(t);
-        let drift = eval3(&self.drift_pos, t) - eval3(&self.drift_pos, self.t0) + self.creep * dt;
+        let drift = eval3(&self.drift_pos, t) - eval3(&self.drift_pos, self.t0);
         let tremor = eval3(&self.tremor_pos, t) * swell;
         let n = DVec3::new(white.normal(), white.normal(), white.normal()) * self.pos_sigma;
         let p = pos + drift + tremor + n;
         let rot_tremor = eval3(&self.tremor_rot, t) * swell;
         let rn = DVec3::new(white.normal(), white.normal(), white.normal()) * self.rot_sigma;
-        let q = DQuat::from_rotation_y(self.yaw_rate * dt)
+        let q = DQuat::from_rotation_y(self.yaw_drift.at(t) - self.yaw_drift.at(self.t0))
             * q
             * DQuat::from_scaled_axis(rot_tremor + rn);
         (p, q.normalize())
+    }
+}
+
+/// Kinds of tracker glitch, chosen uniformly.
+const GLITCH_KINDS: usize = 5;
+
+/// Injects tracker faults into a sample stream with a given probability per sample.
+#[derive(Debug, Clone)]
+pub struct Glitcher {
+    p: f64,
+    rng: SynthRng,
+    /// Number of glitches injected so far.
+    pub count: usize,
+}
+
+impl Glitcher {
+    /// A glitcher with probability `p` per sample (clamped to [0, 0.5]) drawing from `rng`.
+    pub fn new(p: f64, rng: SynthRng) -> Self {
+        let p = if p.is_finite() {
+            p.clamp(0.0, 0.5)
+        } else {
+            0.0
+        };
+        Self { p, rng, count: 0 }
+    }
+
+    /// Possibly corrupts one sample in place: `t` seconds, `pos` metres, `quat` (w, x, y, z);
+    /// `prev_t` is the previous sample's time (`None` for the first sample, never corrupted).
+    pub fn apply(
+        &mut self,
+        prev_t: Option<f64>,
+        t: &mut f64,
+        pos: &mut [f64; 3],
+        quat: &mut [f64; 4],
+    ) {
+        let hit = self.rng.chance(self.p);
+        let kind = self.rng.index(GLITCH_KINDS);
+        let dir =
+            DVec3::new(self.rng.normal(), self.rng.normal(), self.rng.normal()).normalize_or_zero();
+        let size = self.rng.uniform(0.05, 0.5);
+        let back = self.rng.uniform(0.001, 0.02);
+        let Some(prev) = prev_t else { return };
+        if !hit || self.p <= 0.0 {
+            return;
+        }
+        self.count += 1;
+        match kind {
+            0 => {
+                for (p, d) in pos.iter_mut().zip(dir.to_array()) {
+                    *p += d * size;
+                }
+            }
+            1 => {
+                *pos = [f64::NAN; 3];
+                *quat = [f64::NAN; 4];
+            }
+            2 => *quat = [0.0; 4],
+            3 => *t = prev,
+            _ => *t = prev - back,
+        }
     }
 }
 
@@ -138,6 +200,28 @@ impl SensorModel {
 mod tests {
     use super::*;
     use crate::synth::rng::Stream;
+
+    #[test]
+    fn glitches_happen_at_the_asked_rate_and_never_on_the_first_sample() {
+        let mut g = Glitcher::new(0.1, SynthRng::new(4, Stream::Sensor));
+        let mut bad = 0;
+        for i in 0..5000 {
+            let mut t = i as f64 * 0.01;
+            let mut p = [0.0; 3];
+            let mut q = [1.0, 0.0, 0.0, 0.0];
+            let prev = if i == 0 { None } else { Some(t - 0.01) };
+            g.apply(prev, &mut t, &mut p, &mut q);
+            let changed = t != i as f64 * 0.01 || p != [0.0; 3] || q != [1.0, 0.0, 0.0, 0.0];
+            assert!(i > 0 || !changed);
+            bad += usize::from(changed);
+        }
+        assert_eq!(bad, g.count);
+        assert!((400..600).contains(&bad), "{bad}");
+        let mut none = Glitcher::new(0.0, SynthRng::new(4, Stream::Sensor));
+        let (mut t, mut p, mut q) = (1.0, [0.0; 3], [1.0, 0.0, 0.0, 0.0]);
+        none.apply(Some(0.5), &mut t, &mut p, &mut q);
+        assert_eq!(none.count, 0);
+    }
 
     #[test]
     fn clean_model_changes_nothing() {

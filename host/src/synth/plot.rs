@@ -1,6 +1,6 @@
 //! A quick-look picture of a pose log: `figurine synth plot`.
 //!
-//! Four panels, no text (colours carry the meaning):
+//! Four panels, captioned with the tiny built-in font:
 //! * top-left, **top view** (world x → right, z → up, equal aspect): the path from blue (start)
 //!   to red (end, by distance travelled), with short grey ticks showing where the figurine's front points every 0.1 s;
 //! * top-right, **side view** (horizontal distance along the path's main direction → right,
@@ -21,6 +21,7 @@ use glam::{DQuat, DVec3};
 use image::{Rgb, RgbImage};
 
 use super::effort::{TimeClass, WeightClass};
+use super::font::{draw_text, text_width};
 use super::sequence::Label;
 use crate::poselog::PoseLog;
 
@@ -28,6 +29,9 @@ use crate::poselog::PoseLog;
 pub const WIDTH: u32 = 1200;
 /// Picture height, pixels.
 pub const HEIGHT: u32 = 1000;
+
+/// Length of the heading ticks in the top view, pixels.
+const HEADING_TICK_PX: f64 = 12.0;
 
 /// Half-width of the central difference used for speeds, seconds.
 const SPEED_HALF_WINDOW_S: f64 = 0.02;
@@ -182,7 +186,29 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
     for p in [top, side, speed, orient] {
         c.rect(p, grey);
     }
+    let ink = Rgb([60, 60, 60]);
+    for l in labels {
+        let x = tx(speed, l.start) + 3.0;
+        let effort = format!(
+            "{}-{}",
+            short_time(l.time_class),
+            short_weight(l.weight_class)
+        );
+        draw_text(&mut c.img, x as i64, speed.y0 as i64 + 4, &l.action, 2, ink);
+        draw_text(&mut c.img, x as i64, speed.y0 as i64 + 22, &effort, 1, ink);
+    }
+    let mut captions: Vec<(Panel, String, bool)> = vec![
+        (top, "TOP VIEW X-Z, BLUE TO RED".into(), false),
+        (side, "SIDE VIEW, HEIGHT".into(), false),
+        (
+            orient,
+            "YAW GREEN +-2.2PI, PITCH BLUE, ROLL MAGENTA +-PI/2".into(),
+            false,
+        ),
+        (orient, format!("{t_lo:.2} S .. {t_hi:.2} S"), true),
+    ];
     if n < 2 {
+        draw_captions(&mut c, &captions);
         return c.img;
     }
     // Colour by distance travelled, so the direction of motion shows even after long pauses.
@@ -196,11 +222,12 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
     // Top view with heading ticks.
     let xz: Vec<(f64, f64)> = pos.iter().map(|p| (p.x, p.z)).collect();
     let map = fit(&xz, top);
-    let tick_len =
-        0.04 * {
-            let (a, b) = (map((0.0, 0.0)), map((1.0, 0.0)));
-            1.0 / (b.0 - a.0).abs().max(1e-9)
-        } * 18.0;
+    // Heading ticks are a fixed number of pixels long, whatever the zoom.
+    let metres_per_pixel = {
+        let (a, b) = (map((0.0, 0.0)), map((1.0, 0.0)));
+        1.0 / (b.0 - a.0).abs().max(1e-9)
+    };
+    let tick_len = HEADING_TICK_PX * metres_per_pixel;
     let mut next_tick = t_lo;
     for i in 1..n {
         c.line(map(xz[i - 1]), map(xz[i]), ramp(frac(i)));
@@ -254,6 +281,13 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
     let vy = |v: f64, m: f64| speed.y0 + speed.h - v / m * speed.h * 0.95;
     // Grid: light lines at a round step of linear speed, ticks every second of log time.
     let step = nice_step(lmax / 4.0);
+    captions.push((
+        speed,
+        format!(
+            "SPEED BLACK, PEAK {lmax:.2} M/S, GRID {step} M/S; ANGULAR ORANGE, PEAK {amax:.1} RAD/S"
+        ),
+        false,
+    ));
     let mut g = step;
     while g < lmax {
         let y = vy(g, lmax);
@@ -318,22 +352,74 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
         }
         prev = Some((x, cur));
     }
+    draw_captions(&mut c, &captions);
     c.img
 }
 
-/// Tiles small copies of several plots into one picture, `cols` per row, in order.
-pub fn gallery(pictures: &[RgbImage], cols: u32) -> RgbImage {
+/// Writes each caption at the bottom (left, or right when flagged) of its panel, on white.
+fn draw_captions(c: &mut Canvas, captions: &[(Panel, String, bool)]) {
+    for (p, text, right) in captions {
+        let w = f64::from(text_width(text, 2));
+        let x = if *right {
+            p.x0 + p.w - w - 4.0
+        } else {
+            p.x0 + 4.0
+        };
+        let y = p.y0 + p.h - 19.0;
+        for py in y as i64..(y + 17.0) as i64 {
+            for px in (x - 2.0) as i64..(x + w + 1.0) as i64 {
+                c.put(px, py, Rgb([255, 255, 255]));
+            }
+        }
+        draw_text(
+            &mut c.img,
+            x as i64,
+            y as i64 + 2,
+            text,
+            2,
+            Rgb([60, 60, 60]),
+        );
+    }
+}
+
+/// Tiles small copies of several plots into one picture, `cols` per row, in order, each with
+/// its caption written on top.
+pub fn gallery(pictures: &[(RgbImage, String)], cols: u32) -> RgbImage {
     let cols = cols.max(1);
     let (cw, ch) = (WIDTH / 3, HEIGHT / 3);
     let rows = (pictures.len() as u32).div_ceil(cols).max(1);
     let mut out = RgbImage::from_pixel(cols * cw, rows * ch, Rgb([255, 255, 255]));
-    for (i, pic) in pictures.iter().enumerate() {
+    for (i, (pic, caption)) in pictures.iter().enumerate() {
         let small =
             image::imageops::resize(pic, cw - 6, ch - 6, image::imageops::FilterType::Triangle);
         let (x, y) = ((i as u32 % cols) * cw + 3, (i as u32 / cols) * ch + 3);
         image::imageops::replace(&mut out, &small, i64::from(x), i64::from(y));
+        draw_text(
+            &mut out,
+            i64::from(x) + 6,
+            i64::from(y) + 6,
+            caption,
+            2,
+            Rgb([0, 0, 0]),
+        );
     }
     out
+}
+
+fn short_time(t: TimeClass) -> &'static str {
+    match t {
+        TimeClass::Sudden => "SUDDEN",
+        TimeClass::Sustained => "SUSTAINED",
+        TimeClass::Neutral => "NEUTRAL",
+    }
+}
+
+fn short_weight(w: WeightClass) -> &'static str {
+    match w {
+        WeightClass::Strong => "STRONG",
+        WeightClass::Light => "LIGHT",
+        WeightClass::Neutral => "NEUTRAL",
+    }
 }
 
 /// The round number (1, 2 or 5 × 10^k) nearest above `x`.

@@ -2,7 +2,9 @@
 //!
 //! Every random choice of `figurine synth` goes through [`SynthRng`], a PCG-64 generator
 //! (`rand_pcg::Pcg64`, a fixed, documented algorithm) with our own float conversions, so the
-//! same seed gives the same bytes on every machine. Independent concerns (the plan of the
+//! same seed draws the same numbers everywhere. (The trajectory maths then uses the platform's
+//! `sin`/`cos`/`powf`; logs are byte-identical per seed on one platform, and in practice across
+//! x86-64 Linux machines at the CSV's 6 decimals.) Independent concerns (the plan of the
 //! gesture, the sensor imperfections, the sample clock) draw from independent *streams* derived
 //! from the master seed, so changing e.g. the sample rate does not change the doodled path.
 

@@ -7,12 +7,14 @@
 
 use std::path::Path;
 
+use glam::DVec3;
+
 use serde::{Deserialize, Serialize};
 
 use super::effort::{Effort, TimeClass, WeightClass};
 use super::gesture::{plan, Action};
 use super::knobs::{Knobs, Variation};
-use super::noise::SensorModel;
+use super::noise::{Glitcher, SensorModel};
 use super::rng::{Stream, SynthRng};
 use super::sampling::{sample_times, SignPolicy};
 use super::trajectory::{BodyState, Stroke, Trajectory};
@@ -79,68 +81,122 @@ fn to_micros(t: f64) -> f64 {
     (t * 1e6).round() / 1e6
 }
 
-/// Renders the doodle of master `seed` performing `items` in order, with `knobs` ranges.
-pub fn render(seed: u64, knobs: &Knobs, items: &[(Action, Effort)]) -> Doodle {
-    let var = knobs.draw(&mut SynthRng::new(seed, Stream::Knobs));
-    let mut rng = SynthRng::new(seed, Stream::Plan);
-    let initial = BodyState {
-        pos: var.start,
-        yaw: var.heading,
-        pitch: 0.0,
-        roll: 0.0,
-    };
-    let mut traj = Trajectory::new(var.t0, initial);
-    traj.push(Stroke::hold(knobs.lead_s.draw(&mut rng).max(0.05)));
-    let mut labels = Vec::with_capacity(items.len());
-    for &(action, effort) in items {
-        let shape = effort.shape(&mut rng);
-        let strokes = plan(action, &shape, var.scale, &mut rng);
-        let start = traj.end();
-        traj.extend(strokes.into_iter().map(|mut s| {
-            s.duration /= var.speed;
+/// Assembles a doodle performance by performance, then samples it.
+pub struct Performer<'k> {
+    knobs: &'k Knobs,
+    seed: u64,
+    var: Variation,
+    rng: SynthRng,
+    traj: Trajectory,
+    labels: Vec<Label>,
+}
+
+impl<'k> Performer<'k> {
+    /// Draws the nuisance parameters of master `seed` and opens with the still lead-in.
+    pub fn new(seed: u64, knobs: &'k Knobs) -> Self {
+        let var = knobs.draw(&mut SynthRng::new(seed, Stream::Knobs));
+        let mut rng = SynthRng::new(seed, Stream::Plan);
+        let initial = BodyState {
+            pos: var.start,
+            yaw: var.heading,
+            pitch: 0.0,
+            roll: 0.0,
+        };
+        let mut traj = Trajectory::new(var.t0, initial);
+        traj.push(Stroke::hold(knobs.lead_s.draw(&mut rng).max(0.05)));
+        Self {
+            knobs,
+            seed,
+            var,
+            rng,
+            traj,
+            labels: Vec::new(),
+        }
+    }
+
+    /// Where the figurine stands and faces now (after the last pause).
+    pub fn state(&self) -> BodyState {
+        self.traj.last_state()
+    }
+
+    /// Performs `action` with `effort`, labels it, and pauses.
+    pub fn perform(&mut self, action: Action, effort: Effort) {
+        let shape = effort.shape(&mut self.rng);
+        let strokes = plan(action, &shape, self.var.scale, &mut self.rng);
+        let start = self.traj.end();
+        let speed = self.var.speed;
+        self.traj.extend(strokes.into_iter().map(|mut s| {
+            s.duration /= speed;
             s
         }));
-        labels.push(Label {
+        self.labels.push(Label {
             action: action.name().to_string(),
             start: to_micros(start),
-            end: to_micros(traj.end()),
+            end: to_micros(self.traj.end()),
             time_class: effort.time,
             weight_class: effort.weight,
         });
-        traj.push(Stroke::hold(knobs.pause_s.draw(&mut rng).max(0.05)));
+        let pause = self.knobs.pause_s.draw(&mut self.rng).max(0.05);
+        self.traj.push(Stroke::hold(pause));
     }
 
-    let mut sensor_rng = SynthRng::new(seed, Stream::Sensor);
-    let sensor = SensorModel::draw(&mut sensor_rng, var.noise, var.t0);
-    let mut sign = SignPolicy::new(var.sign, var.t0, &mut sensor_rng);
-    let mut clock = SynthRng::new(seed, Stream::Clock);
-    let times = sample_times(
-        traj.start(),
-        traj.end(),
-        var.rate_hz,
-        var.jitter,
-        var.drop,
-        &mut clock,
-    );
-    let samples = times
-        .into_iter()
-        .map(|t| {
+    /// Samples the performed trajectory through the tracker model.
+    pub fn finish(self) -> Doodle {
+        let Self {
+            seed,
+            var,
+            traj,
+            labels,
+            ..
+        } = self;
+        let mut sensor_rng = SynthRng::new(seed, Stream::Sensor);
+        let sensor = SensorModel::draw(&mut sensor_rng, var.noise, var.t0);
+        let mut sign = SignPolicy::new(var.sign, var.t0, &mut sensor_rng);
+        let mut clock = SynthRng::new(seed, Stream::Clock);
+        let times = sample_times(
+            traj.start(),
+            traj.end(),
+            var.rate_hz,
+            var.jitter,
+            var.drop,
+            &mut clock,
+        );
+        let mut glitcher = Glitcher::new(var.glitch, SynthRng::child(seed, Stream::Sensor, 0x611));
+        let mut samples: Vec<PoseSample> = Vec::with_capacity(times.len());
+        for t in times {
             let st = traj.state_at(t);
             let (p, q) = sensor.measure(t, st.pos, st.quat(var.tilt), &mut sensor_rng);
             let q = sign.apply(t, q, &mut sensor_rng);
-            PoseSample {
+            let mut s = PoseSample {
                 t: to_micros(t),
                 pos: p.to_array(),
                 quat: [q.w, q.x, q.y, q.z],
-            }
-        })
-        .collect();
-    Doodle {
-        log: PoseLog { samples },
-        labels,
-        variation: var,
-        seed,
+            };
+            glitcher.apply(
+                samples.last().map(|p| p.t),
+                &mut s.t,
+                &mut s.pos,
+                &mut s.quat,
+            );
+            s.t = to_micros(s.t);
+            samples.push(s);
+        }
+        Doodle {
+            log: PoseLog { samples },
+            labels,
+            variation: var,
+            seed,
+        }
     }
+}
+
+/// Renders the doodle of master `seed` performing `items` in order, with `knobs` ranges.
+pub fn render(seed: u64, knobs: &Knobs, items: &[(Action, Effort)]) -> Doodle {
+    let mut p = Performer::new(seed, knobs);
+    for &(action, effort) in items {
+        p.perform(action, effort);
+    }
+    p.finish()
 }
 
 /// One performance of `action` with `effort`.
@@ -148,18 +204,32 @@ pub fn gesture(seed: u64, knobs: &Knobs, action: Action, effort: Effort) -> Dood
     render(seed, knobs, &[(action, effort)])
 }
 
+/// Horizontal distance (metres) beyond the room's half-size at which a figurine facing away
+/// from the room's centre is turned back before travelling further.
+const ROOM_MARGIN_M: f64 = 0.3;
+
 /// A sequence of `count` random actions, each with a random one of the four effort states
-/// (or `effort` for all), separated by still pauses.
+/// (or `effort` for all), separated by still pauses. Like a child keeping the toy on the table,
+/// a figurine that has wandered out of the room (see [`Knobs::room_m`]) and faces away from its
+/// centre turns (a labelled `turn`) instead of travelling further.
 pub fn sequence(seed: u64, knobs: &Knobs, count: usize, effort: Option<Effort>) -> Doodle {
     let mut pick = SynthRng::child(seed, Stream::Plan, 0x5e9);
-    let items: Vec<(Action, Effort)> = (0..count)
-        .map(|_| {
-            let a = Action::ALL[pick.index(Action::ALL.len())];
-            let e = Effort::random_state(&mut pick);
-            (a, effort.unwrap_or(e))
-        })
-        .collect();
-    render(seed, knobs, &items)
+    let mut p = Performer::new(seed, knobs);
+    let mid = (knobs.room_m.lo + knobs.room_m.hi) / 2.0;
+    let centre = DVec3::new(mid, 0.0, mid);
+    let limit = ((knobs.room_m.hi - knobs.room_m.lo) / 2.0).max(0.5) + ROOM_MARGIN_M;
+    for _ in 0..count {
+        let mut action = Action::ALL[pick.index(Action::ALL.len())];
+        let e = effort.unwrap_or(Effort::random_state(&mut pick));
+        let st = p.state();
+        let out = DVec3::new(st.pos.x - centre.x, 0.0, st.pos.z - centre.z);
+        let forward = DVec3::new(st.yaw.sin(), 0.0, st.yaw.cos());
+        if action.travels() && out.length() > limit && forward.dot(out) > 0.0 {
+            action = Action::Turn;
+        }
+        p.perform(action, e);
+    }
+    p.finish()
 }
 
 /// The seed of the `index`-th doodle of a set generated from master `seed`.

@@ -200,7 +200,8 @@ impl Trajectory {
         if p.stroke.is_hold() {
             return p.state;
         }
-        p.state.advance(&p.stroke, p.stroke.profile.progress(tau))
+        p.state
+            .advance(&p.stroke, p.stroke.profile.progress(tau, p.stroke.duration))
     }
 }
 

@@ -1,0 +1,98 @@
+//! Motion-graph build benchmark: time and peak memory at ~10k, ~27k and ~54k frames (30 fps)
+//! made from the real BVH files (repeated to reach the size).
+//!
+//! `cargo run --release -p figurine-host --example graph_bench` runs each size in its own child
+//! process (so each peak-memory figure, VmHWM from /proc/self/status, is its own) and prints a
+//! table; `… -- FRAMES` runs one size. Needs the data of `cargo xtask setup` (or
+//! FIGURINE_DATA_DIR).
+
+use std::process::Command;
+use std::time::Instant;
+
+use figurine_host::data::require_data_file;
+use figurine_host::graph::build::{build_graph, BuildParams};
+use figurine_host::graph::source::load_clips;
+use figurine_host::graph::{GraphClip, Variant};
+
+const FILES: [&str; 6] = [
+    "lafan_dance1.bvh",
+    "lafan_test.bvh",
+    "blender_gestures.bvh",
+    "mocapbank_kneel.bvh",
+    "sword_attack.bvh",
+    "mixamo_walk_turn.bvh",
+];
+const SIZES: [usize; 3] = [10_000, 27_000, 54_000];
+
+/// Peak resident memory of this process, MiB (VmHWM).
+fn peak_mib() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// The library repeated (and the last copy cut) to exactly `frames` frames.
+fn library(base: &[GraphClip], frames: usize) -> Vec<GraphClip> {
+    let mut out = Vec::new();
+    let mut total = 0;
+    'outer: for rep in 0.. {
+        for c in base {
+            let left = frames - total;
+            if left < figurine_host::graph::WINDOW {
+                break 'outer;
+            }
+            let mut c = c.clone();
+            c.clip.name = format!("{}#{rep}", c.clip.name);
+            if c.len() > left {
+                c.points.truncate(left);
+                c.clip.frames.truncate(left);
+            }
+            total += c.len();
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn one(frames: usize) -> anyhow::Result<()> {
+    let paths = FILES
+        .iter()
+        .map(|f| require_data_file("bvh", f))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let base = load_clips(&paths, &Default::default())?;
+    let clips = library(&base, frames);
+    let n: usize = clips.iter().map(|c| c.len()).sum();
+    let t = Instant::now();
+    let (g, st) = build_graph(&clips, &BuildParams::default())?;
+    let secs = t.elapsed().as_secs_f64();
+    println!(
+        "{n:>7} frames  {:>8.2} s  peak {:>7.1} MiB  | pairs {:.3e}  local maxima {}  MG {}  LMA-MG {}  | lma {:.2} s posture {:.2} s style {:.2} s",
+        secs,
+        peak_mib().unwrap_or(f64::NAN),
+        st.pairs as f64,
+        st.local_minima,
+        g.count(Variant::Mg, None, None),
+        g.count(Variant::Lma, None, None),
+        st.lma_seconds,
+        st.posture_seconds,
+        st.style_seconds
+    );
+    Ok(())
+}
+
+fn main() -> anyhow::Result<()> {
+    if let Some(arg) = std::env::args().nth(1) {
+        return one(arg.parse()?);
+    }
+    println!(
+        "graph build on {} threads (real BVH data repeated; 30 fps; T_MG 0.9, T_LMA 0.8)",
+        rayon::current_num_threads()
+    );
+    let exe = std::env::current_exe()?;
+    for size in SIZES {
+        let status = Command::new(&exe).arg(size.to_string()).status()?;
+        anyhow::ensure!(status.success(), "benchmark at {size} frames failed");
+    }
+    Ok(())
+}

@@ -1,0 +1,572 @@
+//! The assembler: recognised actions + doodle → one character animation (seed 000 §6).
+//!
+//! For each event (in time order) the action's clip gets its efforts (retime, rescale,
+//! reshape), is stretched over the event's `[start, end]` (output frame f shows log time
+//! `t_origin + f / fps`, so timing matches the events), and is placed in the world:
+//! - **in place**: at the character's spot, facing its current heading; the clip's own small
+//!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
+//! - **moving, cyclic** (walk, run): whole cycles, as many as fit the path (`round(L / C)`,
+//!   C = the clip's travel per cycle); the root advances along the path by the clip's own
+//!   progress (stretched by `L / (m C)`), so feet do not skate; heading = path tangent;
+//! - **moving, not cyclic** (jump): the root stays in place while the clip's own root does
+//!   not travel (anticipation, landing, follow-through) and moves along the path, in step
+//!   with the clip's own travel, during the execution (stage boundaries from phrasing can
+//!   fall inside the take-off, so the clip's travel, not the label, decides).
+//!
+//! Actions start at their event's start; an event shorter than its clip allows at
+//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
+//! Between consecutive actions the best frames by windowed posture distance are joined by a
+//! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
+//! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted
+//! foot where its contact began, undoing slides from rescaling, path stretching and blends),
+//! and ground penetration is removed with two-bone IK.
+
+use std::collections::BTreeMap;
+
+use glam::{Quat, Vec2, Vec3};
+
+use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
+use super::effort::{apply_effort, Effort, EffortClip};
+use super::library::ActionClip;
+use super::phrasing::{detect_stages, Phrasing, Stage};
+use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
+use super::transition::{best_pair, blend_world, smoothstep};
+use super::AnimError;
+use crate::events::ActionRecord;
+use crate::motion::{Clip, Pose};
+use crate::poselog::PoseLog;
+
+/// Fastest playback of a clip relative to its own speed (before effort retiming).
+pub const MAX_SPEEDUP: f32 = 3.0;
+
+/// Knobs of the assembler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AssembleOptions {
+    /// Toy metres → character metres.
+    pub world_scale: f32,
+    /// Output frames per second.
+    pub fps: f32,
+    /// Seconds the final pose is held after the last action.
+    pub hold_s: f32,
+    /// How far (seconds) from an action boundary the transition search looks.
+    pub transition_search_s: f32,
+    /// Minimum blend duration, seconds.
+    pub min_blend_s: f32,
+}
+
+impl Default for AssembleOptions {
+    fn default() -> Self {
+        AssembleOptions {
+            world_scale: DEFAULT_WORLD_SCALE,
+            fps: 30.0,
+            hold_s: 0.5,
+            transition_search_s: 0.25,
+            min_blend_s: 0.2,
+        }
+    }
+}
+
+/// Where and when one action was placed.
+#[derive(Debug, Clone)]
+pub struct Placement {
+    /// Action name.
+    pub action: String,
+    /// Output frames `start_frame..=end_frame` hold the action.
+    pub start_frame: usize,
+    /// Last frame of the action.
+    pub end_frame: usize,
+    /// The world ground path the root should follow (moving actions), metres.
+    pub path: Polyline,
+    /// Whether the action travels along the doodle.
+    pub moving: bool,
+    /// Cycles played (cyclic actions), else 1.
+    pub cycles: usize,
+    /// Stages on the log's clock: (stage, start s, end s).
+    pub stages: Vec<(Stage, f32, f32)>,
+}
+
+/// The assembled animation and what was done to make it.
+#[derive(Debug, Clone)]
+pub struct Assembly {
+    /// The animation (metres, seconds), root in world space.
+    pub clip: Clip,
+    /// One placement per assembled event.
+    pub placements: Vec<Placement>,
+    /// Per leg, per frame: the foot is planted (from the source clips' contacts at the frames'
+    /// source times), and was pinned there.
+    pub contacts: Vec<Vec<bool>>,
+    /// The ground pass's report.
+    pub ground: GroundFix,
+    /// Transitions: (frame where the blend starts, frame where it ends).
+    pub transitions: Vec<(usize, usize)>,
+    /// Log-clock time (seconds) of output frame 0: the doodle's first sample, else 0 (or the
+    /// first event's start if it is negative). Frame f shows log time `t_origin + f / fps`.
+    pub t_origin: f64,
+}
+
+/// One placed action: its frames on the output clock.
+struct Placed {
+    f0: usize,
+    poses: Vec<Pose>,
+    /// Per frame, per leg: the source clip's foot contact at the frame's source time.
+    contacts: Vec<Vec<bool>>,
+}
+
+impl Placed {
+    fn f1(&self) -> usize {
+        self.f0 + self.poses.len().saturating_sub(1)
+    }
+
+    fn contact_at(&self, f: usize) -> Vec<bool> {
+        let k = f
+            .saturating_sub(self.f0)
+            .min(self.contacts.len().saturating_sub(1));
+        self.contacts.get(k).cloned().unwrap_or_default()
+    }
+
+    fn at(&self, f: usize) -> &Pose {
+        let k = f
+            .saturating_sub(self.f0)
+            .min(self.poses.len().saturating_sub(1));
+        &self.poses[k]
+    }
+}
+
+/// Character state carried from one action to the next.
+struct Cursor {
+    pos: Vec2,
+    heading: Vec2,
+}
+
+/// Assembles an animation. `clips` must map every event's action (see
+/// [`super::library::ClipLibrary::load`]); `forward` is the rig's facing in its clips.
+pub fn assemble(
+    events: &[ActionRecord],
+    doodle: Option<&PoseLog>,
+    clips: &BTreeMap<String, ActionClip>,
+    forward: Vec3,
+    opts: &AssembleOptions,
+) -> Result<Assembly, AnimError> {
+    if events.is_empty() {
+        return Err(AnimError::Data(
+            "no actions to animate (the event list is empty)".into(),
+        ));
+    }
+    if !(opts.fps.is_finite()
+        && opts.fps >= 1.0
+        && opts.world_scale.is_finite()
+        && opts.world_scale > 0.0)
+    {
+        return Err(AnimError::Data(format!(
+            "bad options: fps {} and world scale {} must be positive",
+            opts.fps, opts.world_scale
+        )));
+    }
+    let mut missing: Vec<String> = events
+        .iter()
+        .filter(|e| !clips.contains_key(&e.action))
+        .map(|e| e.action.clone())
+        .collect();
+    if !missing.is_empty() {
+        missing.sort();
+        missing.dedup();
+        return Err(AnimError::MissingClips {
+            library: "the loaded clips".into(),
+            missing,
+            available: clips.keys().cloned().collect(),
+        });
+    }
+    let mut evs: Vec<ActionRecord> = events
+        .iter()
+        .filter(|e| e.start.is_finite() && e.end.is_finite())
+        .cloned()
+        .collect();
+    evs.sort_by(|a, b| a.start.total_cmp(&b.start));
+    let path = doodle.map(|d| GroundPath::from_log(d, opts.world_scale));
+    // Output time 0 is the doodle's first sample (or the log clock's 0 without a doodle).
+    let first_event = evs.first().map(|e| e.start).unwrap_or(0.0);
+    let t_shift = match path.as_ref().and_then(|p| p.t.first()) {
+        Some(&t0) => (t0 as f64).min(first_event),
+        None => first_event.min(0.0),
+    };
+    let fps = opts.fps;
+    let frame_of = |t: f64| ((t - t_shift) as f32 * fps).round().max(0.0) as usize;
+
+    let skeleton = clips
+        .values()
+        .next()
+        .map(|c| c.clip.skeleton.clone())
+        .unwrap_or_default();
+    let mut phrasings: BTreeMap<String, Phrasing> = BTreeMap::new();
+    let mut source_contacts: BTreeMap<String, Vec<Vec<bool>>> = BTreeMap::new();
+    let legs = clips
+        .values()
+        .next()
+        .map(|c| find_legs(&c.clip))
+        .unwrap_or_default();
+    let mut cursor = Cursor {
+        pos: Vec2::ZERO,
+        heading: initial_heading(doodle),
+    };
+    let mut placed: Vec<Placed> = Vec::new();
+    let mut placements: Vec<Placement> = Vec::new();
+    let mut last_f1 = 0usize;
+    for ev in &evs {
+        let Some(ac) = clips.get(&ev.action) else {
+            continue;
+        };
+        let mut f0 = frame_of(ev.start);
+        if !placed.is_empty() && f0 < last_f1 {
+            f0 = last_f1; // overlapping events: the later one starts when the earlier ends
+        }
+        let phrasing = phrasings
+            .entry(ev.action.clone())
+            .or_insert_with(|| {
+                if ac.cyclic {
+                    Phrasing::whole(&ac.clip)
+                } else {
+                    detect_stages(&ac.clip)
+                }
+            })
+            .clone();
+        let effort = Effort {
+            time: ev.time as f32,
+            weight: ev.weight as f32,
+        };
+        let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
+        let chunk = match &path {
+            _ if !ac.moving => Polyline::new(Vec::new()),
+            Some(p) => p.chunk(ev.start as f32, ev.end as f32),
+            None => natural_path(ac, (ev.end - ev.start) as f32),
+        };
+        // Never faster than MAX_SPEEDUP × the clip (all its cycles): a too-short event overruns
+        // into the pause after it (the next action waits if it must).
+        let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
+        let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
+        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        let duration = (f1 - f0) as f32 / fps;
+        let (poses, world_path, cycles, src_times) =
+            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+        let src_contacts = source_contacts
+            .entry(ev.action.clone())
+            .or_insert_with(|| detect_contacts(&ac.clip, &legs))
+            .clone();
+        let contacts = src_times
+            .iter()
+            .map(|&t| {
+                let k = (t / ac.clip.frame_time.max(1e-6)).round().max(0.0) as usize;
+                src_contacts
+                    .iter()
+                    .map(|leg| leg.get(k).copied().unwrap_or(false))
+                    .collect()
+            })
+            .collect();
+        let stages = ec
+            .phrasing
+            .spans
+            .iter()
+            .filter_map(|s| {
+                let (a, b) = ec.stage_w(s.stage)?;
+                let t0 = f0 as f32 / fps + t_shift as f32;
+                Some((s.stage, t0 + a * duration, t0 + b * duration))
+            })
+            .collect();
+        placements.push(Placement {
+            action: ev.action.clone(),
+            start_frame: f0,
+            end_frame: f1,
+            path: world_path,
+            moving: ac.moving,
+            cycles,
+            stages,
+        });
+        placed.push(Placed {
+            f0,
+            poses,
+            contacts,
+        });
+        last_f1 = f1;
+    }
+
+    // Timeline with transitions.
+    let total = last_f1 + (opts.hold_s.max(0.0) * fps).round() as usize;
+    let search = ((opts.transition_search_s * fps).round() as usize).max(1);
+    let min_blend = ((opts.min_blend_s * fps).round() as usize).max(2);
+    let mut cuts: Vec<(usize, usize)> = Vec::new(); // (i, j) per boundary
+    for w in placed.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let ra = a.f1().saturating_sub(search).max(a.f0)..=a.f1();
+        let rb = b.f0..=(b.f0 + search).min(b.f1());
+        let pa: Vec<Vec<Vec3>> = (0..=a.f1())
+            .map(|f| {
+                if f < a.f0 {
+                    Vec::new()
+                } else {
+                    skeleton.positions(a.at(f))
+                }
+            })
+            .collect();
+        let pb: Vec<Vec<Vec3>> = (0..=b.f1())
+            .map(|f| {
+                if f < b.f0 {
+                    Vec::new()
+                } else {
+                    skeleton.positions(b.at(f))
+                }
+            })
+            .collect();
+        let (mut i, mut j) = match best_pair(&pa, ra.clone(), &pb, rb.clone()) {
+            Some((i, j, _)) => (i, j),
+            None => (a.f1(), b.f0),
+        };
+        if j < i + min_blend {
+            let need = i + min_blend - j;
+            let back = (need / 2).min(i - a.f0);
+            i -= back;
+            j = (j + need - back).min(b.f1());
+        }
+        cuts.push((i, j));
+    }
+    let mut frames = Vec::with_capacity(total + 1);
+    let mut contact_frames: Vec<Vec<bool>> = Vec::with_capacity(total + 1);
+    for f in 0..=total {
+        // Which placed action owns frame f, or which transition covers it.
+        let mut pose = placed[0].at(f).clone();
+        let mut contact = placed[0].contact_at(f);
+        for (k, p) in placed.iter().enumerate() {
+            let start_cut = if k == 0 { 0 } else { cuts[k - 1].1 };
+            let end_cut = cuts.get(k).map(|c| c.0).unwrap_or(usize::MAX);
+            if f >= start_cut && f <= end_cut {
+                pose = p.at(f).clone();
+                contact = p.contact_at(f);
+                break;
+            }
+            if let (Some(&(i, j)), Some(next)) = (cuts.get(k), placed.get(k + 1)) {
+                if f > i && f < j {
+                    let u = smoothstep((f - i) as f32 / (j - i) as f32);
+                    pose = blend_world(p.at(f), next.at(f), u);
+                    // A blended foot is planted only if both sides plant it.
+                    contact = p
+                        .contact_at(f)
+                        .iter()
+                        .zip(next.contact_at(f))
+                        .map(|(a, b)| *a && b)
+                        .collect();
+                    break;
+                }
+            }
+        }
+        frames.push(pose);
+        contact_frames.push(contact);
+    }
+    let mut clip = Clip {
+        name: "figurine".into(),
+        skeleton,
+        frame_time: 1.0 / fps,
+        frames,
+    };
+    // Per leg, per frame.
+    let contacts: Vec<Vec<bool>> = (0..legs.len())
+        .map(|l| {
+            contact_frames
+                .iter()
+                .map(|c| c.get(l).copied().unwrap_or(false))
+                .collect()
+        })
+        .collect();
+    pin_feet(&mut clip, &legs, &contacts);
+    let ground = fix_ground(&mut clip, &legs);
+    Ok(Assembly {
+        clip,
+        placements,
+        contacts,
+        ground,
+        transitions: cuts,
+        t_origin: t_shift,
+    })
+}
+
+/// The toy's facing (object +Z) at the first sample, projected to the ground; +X otherwise.
+fn initial_heading(doodle: Option<&PoseLog>) -> Vec2 {
+    doodle
+        .and_then(|d| {
+            d.samples
+                .iter()
+                .find(|s| s.quat.iter().all(|v| v.is_finite()))
+        })
+        .map(|s| {
+            let [w, x, y, z] = s.quat.map(|v| v as f32);
+            let q = Quat::from_xyzw(x, y, z, w);
+            let f = if q.length() > 1e-6 {
+                q.normalize() * Vec3::Z
+            } else {
+                Vec3::X
+            };
+            ground(f)
+        })
+        .filter(|g| g.length() > 0.2)
+        .map(|g| g.normalize())
+        .unwrap_or(Vec2::X)
+}
+
+/// Without a doodle, moving actions travel as far as their clip does, straight ahead.
+fn natural_path(ac: &ActionClip, duration: f32) -> Polyline {
+    let root = ac.clip.root_path();
+    let travel = match (root.first(), root.last()) {
+        (Some(a), Some(b)) => ground(*b - *a).length(),
+        _ => 0.0,
+    };
+    let len = if ac.cyclic {
+        let cycles = (duration / ac.clip.duration().max(1e-3)).round().max(1.0);
+        travel * cycles
+    } else {
+        travel
+    };
+    Polyline::new(vec![Vec2::ZERO, Vec2::new(len, 0.0)])
+}
+
+/// Places one action on `n + 1` output frames, playing `cycles` cycles; returns the poses (root in world), the world
+/// path it followed, the number of cycles and each frame's source time (s). Updates the cursor.
+fn place_action(
+    ac: &ActionClip,
+    ec: &EffortClip,
+    chunk: &Polyline,
+    cursor: &mut Cursor,
+    forward: Vec3,
+    n: usize,
+    cycles: usize,
+) -> (Vec<Pose>, Polyline, usize, Vec<f32>) {
+    let clip = &ec.clip;
+    let src_root = clip.root_path();
+    let r0 = src_root.first().copied().unwrap_or(Vec3::ZERO);
+    let rl = src_root.last().copied().unwrap_or(r0);
+    let q0 = clip
+        .frames
+        .first()
+        .map(|p| p.rotations[0])
+        .unwrap_or(Quat::IDENTITY);
+    let ql = clip.frames.last().map(|p| p.rotations[0]).unwrap_or(q0);
+    let facing0 = ground(q0 * forward).normalize_or(Vec2::X);
+    let net = ground(rl - r0);
+    let clip_dir = if ac.moving && net.length() > 0.05 {
+        net.normalize()
+    } else {
+        facing0
+    };
+    let along = |v: Vec3| ground(v).dot(clip_dir);
+    let across = |v: Vec3| {
+        let g = ground(v);
+        g - clip_dir * g.dot(clip_dir)
+    };
+    let moving = ac.moving && chunk.length() > 0.05;
+    // Orient the path: it starts at the character's position.
+    let world_path = Polyline::new(chunk.pts.iter().map(|p| cursor.pos + *p).collect());
+    let start_heading = if moving {
+        chunk.tangent_at(0.0, 0.3).unwrap_or(cursor.heading)
+    } else {
+        cursor.heading
+    };
+    let r_start = yaw_between(clip_dir, start_heading);
+    let base = cursor.pos;
+    let cycle_len = along(rl - r0);
+    let stretch = if cycles > 0 && cycle_len > 0.05 {
+        chunk.length() / (cycles as f32 * cycle_len)
+    } else {
+        1.0
+    };
+    // Yaw drift of one cycle, removed so cycles join without a turn.
+    let drift = if ac.cyclic {
+        let a = ground(q0 * forward).normalize_or(Vec2::X);
+        let b = ground(ql * forward).normalize_or(Vec2::X);
+        super::trajectory::yaw(b) - super::trajectory::yaw(a)
+    } else {
+        0.0
+    };
+    let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
+    let mut sigma_max = 0.0f32;
+    let mut poses = Vec::with_capacity(n + 1);
+    let mut src_times = Vec::with_capacity(n + 1);
+    for k in 0..=n {
+        let u = k as f32 / n.max(1) as f32;
+        let (w, cycle) = if ac.cyclic {
+            let uc = u * cycles as f32;
+            let c = (uc.floor() as usize).min(cycles - 1);
+            (uc - c as f32, c)
+        } else {
+            (u, 0)
+        };
+        let src_t = ec.source_time(w);
+        src_times.push(src_t);
+        let mut pose = ec.clip.sample(src_t);
+        let r = pose.translations[0];
+        let q = pose.rotations[0];
+        let (root_xz, rot) = if !moving {
+            let drift = if ac.anchor {
+                ground(rl - r0) * (ec.source_time(w) / clip.duration().max(1e-6))
+            } else {
+                Vec2::ZERO
+            };
+            (base + rot2(r_start, ground(r - r0) - drift), r_start)
+        } else if ac.cyclic {
+            let s = (cycle as f32 * cycle_len + along(r - r0)) * stretch;
+            let tangent = chunk.tangent_at(s, 0.3).unwrap_or(start_heading);
+            let rt = yaw_between(clip_dir, tangent) * Quat::from_rotation_y(-drift * w);
+            (
+                cursor.pos + chunk.point_at(s) + rot2(rt, across(r - r0)),
+                rt,
+            )
+        } else {
+            // Not cyclic: the root stays put while the clip's own root does not travel
+            // (anticipation, landing) and follows the path in step with the clip's travel
+            // during the execution; never backwards.
+            let total = along(rl - r0);
+            let sigma = if total.abs() > 0.05 {
+                (along(r - r0) / total).clamp(0.0, 1.0)
+            } else {
+                ((w - exec.0) / (exec.1 - exec.0).max(1e-6)).clamp(0.0, 1.0)
+            };
+            sigma_max = sigma_max.max(sigma);
+            let s = sigma_max * chunk.length();
+            let tangent = chunk.tangent_at(s, 0.3).unwrap_or(start_heading);
+            (
+                cursor.pos + chunk.point_at(s),
+                yaw_between(clip_dir, tangent),
+            )
+        };
+        pose.translations[0] = Vec3::new(root_xz.x, r.y, root_xz.y);
+        pose.rotations[0] = (rot * q).normalize();
+        poses.push(pose);
+    }
+    if let Some(last) = poses.last() {
+        let t = last.translations[0];
+        cursor.pos = Vec2::new(t.x, t.z);
+        let f = ground(last.rotations[0] * forward);
+        if f.length() > 0.2 {
+            cursor.heading = f.normalize();
+        }
+    }
+    (poses, world_path, cycles, src_times)
+}
+
+/// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
+/// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
+/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put); 1 otherwise.
+fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
+    let root = ec.clip.root_path();
+    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
+        return 1;
+    };
+    let cycle_len = ground(rl - r0).length();
+    if ac.cyclic && ac.moving && chunk.length() > 0.05 && cycle_len > 0.05 {
+        let by_path = (chunk.length() / cycle_len).round() as usize;
+        let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
+        by_path.min(by_time).max(1)
+    } else {
+        1
+    }
+}
+
+/// Rotates a ground vector by a yaw quaternion.
+fn rot2(q: Quat, v: Vec2) -> Vec2 {
+    ground(q * Vec3::new(v.x, 0.0, v.y))
+}

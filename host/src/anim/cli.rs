@@ -1,0 +1,358 @@
+//! `figurine animate` and `figurine clip stages`: argument structs and their runners.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+
+use super::assemble::{assemble, AssembleOptions, Assembly};
+use super::library::ClipLibrary;
+use super::phrasing::detect_stages;
+use super::plot::save_contact_sheet;
+use super::trajectory::DEFAULT_WORLD_SCALE;
+use crate::events::{read_events_path, ActionRecord};
+use crate::motion::{read_bvh_path, read_deepmimic_path, write_bvh_path, write_glb_path, Clip};
+use crate::poselog::PoseLog;
+
+/// `figurine animate`: assemble a character animation from recognised actions and the doodle.
+#[derive(clap::Args, Debug)]
+pub struct AnimateArgs {
+    /// Recognizer action library (used when recognising LOG; default: built-in).
+    #[arg(long)]
+    pub library: Option<PathBuf>,
+    /// Recognizer effort model (used when recognising LOG; default: built-in).
+    #[arg(long)]
+    pub effort: Option<PathBuf>,
+    /// Clip library (action → clip); the built-in DeepMimic library when absent.
+    #[arg(long)]
+    pub clips: Option<PathBuf>,
+    /// Recognised actions as JSON lines (the output of `figurine simulate`).
+    #[arg(long)]
+    pub events: Option<PathBuf>,
+    /// Ground-truth labels of `figurine synth` (JSON array) used as the events, with each
+    /// Laban class mapped to ±[`LABEL_EFFORT`] (demo and tests without recognition).
+    #[arg(long, conflicts_with = "events")]
+    pub labels: Option<PathBuf>,
+    /// The doodle's pose log, whose path the character follows (defaults to LOG).
+    #[arg(long)]
+    pub doodle: Option<PathBuf>,
+    /// Pose log to recognise (and follow).
+    pub log: Option<PathBuf>,
+    /// Output BVH file.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write a binary glTF (.glb).
+    #[arg(long)]
+    pub glb: Option<PathBuf>,
+    /// Toy metres → character metres.
+    #[arg(long, default_value_t = DEFAULT_WORLD_SCALE)]
+    pub world_scale: f32,
+    /// Output frames per second.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f32,
+    /// Also draw a contact sheet (root path over the doodle path, stick figures) to this PNG.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+/// Effort value given to a labelled Laban class (sudden/strong +, sustained/light −).
+pub const LABEL_EFFORT: f64 = 0.8;
+
+/// Reads `figurine synth` labels as action events (classes → ±[`LABEL_EFFORT`], neutral 0).
+pub fn read_label_events(path: &Path) -> anyhow::Result<Vec<ActionRecord>> {
+    use crate::synth::effort::{TimeClass, WeightClass};
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let labels: Vec<crate::synth::sequence::Label> = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line()))?;
+    Ok(labels
+        .into_iter()
+        .map(|l| ActionRecord {
+            action: l.action,
+            start: l.start,
+            end: l.end,
+            time: match l.time_class {
+                TimeClass::Sudden => LABEL_EFFORT,
+                TimeClass::Sustained => -LABEL_EFFORT,
+                TimeClass::Neutral => 0.0,
+            },
+            weight: match l.weight_class {
+                WeightClass::Strong => LABEL_EFFORT,
+                WeightClass::Light => -LABEL_EFFORT,
+                WeightClass::Neutral => 0.0,
+            },
+            distance: 0,
+        })
+        .collect())
+}
+
+/// `figurine clip …`: inspect motion clips.
+#[derive(clap::Args, Debug)]
+pub struct ClipArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: ClipCommand,
+}
+
+/// Subcommands of `figurine clip`.
+#[derive(clap::Subcommand, Debug)]
+pub enum ClipCommand {
+    /// Print the motion stages (§6.1) of a clip: an action of the clip library, a .bvh file or
+    /// a DeepMimic motion file.
+    Stages {
+        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        clip: String,
+        /// Clip library to look action names up in (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// URDF for DeepMimic files (default: the data folder's humanoid.urdf).
+        #[arg(long)]
+        urdf: Option<PathBuf>,
+    },
+    /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
+    /// to a PNG.
+    Plot {
+        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        clip: String,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        /// Clip library to look action names up in (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// URDF for DeepMimic files (default: the data folder's humanoid.urdf).
+        #[arg(long)]
+        urdf: Option<PathBuf>,
+        /// Length unit → metres (e.g. 0.01 for centimetre BVH).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f32,
+        /// The rig's facing direction in its clips, x,y,z (DeepMimic: 1,0,0).
+        #[arg(long, default_value = "1,0,0")]
+        forward: String,
+    },
+}
+
+/// Runs `figurine animate`.
+pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
+    let events = match (&args.events, &args.labels, &args.log) {
+        (Some(e), _, _) => read_events_path(e)?,
+        (None, Some(l), _) => read_label_events(l)?,
+        (None, None, Some(log)) => recognise(log, args)?,
+        (None, None, None) => bail!(
+            "give --events EVENTS.jsonl (or --labels LABELS.json) and --doodle LOG.csv, or a LOG \
+             to recognise"
+        ),
+    };
+    let doodle_path = args.doodle.as_ref().or(args.log.as_ref());
+    let doodle = doodle_path.map(|p| PoseLog::read_path(p)).transpose()?;
+    let library = match &args.clips {
+        Some(p) => ClipLibrary::read_path(p)?,
+        None => ClipLibrary::default_library()?,
+    };
+    let actions: Vec<&str> = events.iter().map(|e| e.action.as_str()).collect();
+    let clips = library.load(actions.iter().copied())?;
+    let opts = AssembleOptions {
+        world_scale: args.world_scale,
+        fps: args.fps,
+        ..AssembleOptions::default()
+    };
+    let asm = assemble(&events, doodle.as_ref(), &clips, library.forward(), &opts)?;
+    write_bvh_path(&asm.clip, &args.out)?;
+    if let Some(glb) = &args.glb {
+        write_glb_path(&asm.clip, 1.0, glb)?;
+    }
+    if let Some(png) = &args.plot {
+        plot_assembly(&asm, library.forward(), png)?;
+    }
+    print_summary(&asm, &args.out, args.glb.as_deref());
+    Ok(())
+}
+
+/// Runs the recognizer (the same code as `figurine simulate`) over a pose log.
+fn recognise(log: &Path, args: &AnimateArgs) -> anyhow::Result<Vec<ActionRecord>> {
+    use crate::recognize::simulate::{load_effort, load_library, simulate_log};
+    let (lib, blob) = load_library(args.library.as_deref())?;
+    let effort = load_effort(args.effort.as_deref())?;
+    let pose_log = PoseLog::read_path(log)?;
+    let sim = simulate_log(&pose_log, &lib.names(), &blob, Some(effort))
+        .with_context(|| format!("recognising {}", log.display()))?;
+    if sim.records.is_empty() {
+        bail!(
+            "the recognizer found no actions in {} (try `figurine tokens` / `figurine simulate` \
+             on it, or pass --events)",
+            log.display()
+        );
+    }
+    Ok(sim.records)
+}
+
+/// Draws the assembly's contact sheet: every action's path and a figure per action.
+pub fn plot_assembly(asm: &Assembly, forward: glam::Vec3, png: &Path) -> anyhow::Result<()> {
+    let target: Vec<glam::Vec3> = asm
+        .placements
+        .iter()
+        .filter(|p| p.moving)
+        .flat_map(|p| {
+            p.path
+                .pts
+                .iter()
+                .map(|q| glam::Vec3::new(q.x, 0.0, q.y))
+                .chain([glam::Vec3::NAN])
+        })
+        .collect();
+    // Two to four figures per action, twelve at most.
+    let per = (super::plot::MAX_FIGURES / asm.placements.len().max(1)).clamp(2, 4);
+    let frames: Vec<usize> = asm
+        .placements
+        .iter()
+        .flat_map(|p| {
+            let n = p.end_frame - p.start_frame;
+            (0..per).map(move |k| p.start_frame + n * (2 * k + 1) / (2 * per))
+        })
+        .collect();
+    save_contact_sheet(&asm.clip, &frames, &target, forward, png)
+}
+
+fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
+    let c = &asm.clip;
+    println!(
+        "{}: {} frames @ {:.0} fps ({:.2} s from log time {:.2} s), {} actions, {} transitions",
+        out.display(),
+        c.len(),
+        c.fps(),
+        c.duration(),
+        asm.t_origin,
+        asm.placements.len(),
+        asm.transitions.len()
+    );
+    if let Some(g) = glb {
+        println!("{}: binary glTF", g.display());
+    }
+    for p in &asm.placements {
+        let stages: Vec<String> = p
+            .stages
+            .iter()
+            .map(|(s, a, b)| format!("{s} {a:.2}-{b:.2}"))
+            .collect();
+        println!(
+            "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]",
+            p.action,
+            asm.t_origin as f32 + p.start_frame as f32 * c.frame_time,
+            asm.t_origin as f32 + p.end_frame as f32 * c.frame_time,
+            if p.moving { "moving" } else { "in place" },
+            if p.cycles > 1 {
+                format!(" ×{}", p.cycles)
+            } else {
+                String::new()
+            },
+            p.path.length(),
+            stages.join(", ")
+        );
+    }
+    let contact_frames: Vec<usize> = asm
+        .contacts
+        .iter()
+        .map(|l| l.iter().filter(|c| **c).count())
+        .collect();
+    println!(
+        "  ground: deepest penetration {:.3} m fixed (IK on {} frames, root raised on {}); foot contact frames per leg {:?}",
+        asm.ground.max_depth, asm.ground.ik_frames, asm.ground.raised_frames, contact_frames
+    );
+}
+
+/// Loads a clip named on the command line: a library action, a .bvh or a DeepMimic file.
+pub fn load_named_clip(
+    name: &str,
+    clips: Option<&Path>,
+    urdf: Option<&Path>,
+) -> anyhow::Result<(Clip, bool)> {
+    let p = Path::new(name);
+    let ext = p
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("bvh") => Ok((read_bvh_path(p)?.clip, false)),
+        Some("txt") | Some("json") if p.is_file() => {
+            let urdf = match urdf {
+                Some(u) => u.to_path_buf(),
+                None => crate::data::require_data_file("deepmimic", "humanoid.urdf")?,
+            };
+            Ok((read_deepmimic_path(p, &urdf)?.clip, false))
+        }
+        _ => {
+            let lib = match clips {
+                Some(c) => ClipLibrary::read_path(c)?,
+                None => ClipLibrary::default_library()?,
+            };
+            let mut loaded = lib.load([name]).with_context(|| {
+                format!(
+                    "{name} is neither a clip file nor an action of {}",
+                    lib.origin
+                )
+            })?;
+            let ac = loaded.remove(name).context("action vanished")?;
+            Ok((ac.clip, ac.cyclic))
+        }
+    }
+}
+
+/// Runs `figurine clip …`.
+pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
+    match &args.command {
+        ClipCommand::Stages { clip, clips, urdf } => {
+            let (c, cyclic) = load_named_clip(clip, clips.as_deref(), urdf.as_deref())?;
+            let ph = detect_stages(&c);
+            println!(
+                "{}: {} frames @ {:.1} fps ({:.2} s), {} stages{}",
+                c.name,
+                c.len(),
+                c.fps(),
+                c.duration(),
+                ph.spans.len(),
+                if cyclic {
+                    " (cyclic: animate plays it as one execution stage)"
+                } else {
+                    ""
+                }
+            );
+            println!("{:15} {:>11} {:>15}", "stage", "frames", "seconds");
+            for s in &ph.spans {
+                println!(
+                    "{:15} {:>5}-{:<5} {:>7.3}-{:<7.3}",
+                    s.stage.to_string(),
+                    s.start,
+                    s.end,
+                    s.start as f32 * c.frame_time,
+                    s.end as f32 * c.frame_time
+                );
+            }
+            Ok(())
+        }
+        ClipCommand::Plot {
+            clip,
+            out,
+            clips,
+            urdf,
+            scale,
+            forward,
+        } => {
+            let (mut c, _) = load_named_clip(clip, clips.as_deref(), urdf.as_deref())?;
+            c.scale_lengths(*scale);
+            let f: Vec<f32> = forward
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--forward {forward:?}: expected x,y,z"))?;
+            let fwd = match f.as_slice() {
+                [x, y, z] => glam::Vec3::new(*x, *y, *z),
+                _ => bail!("--forward {forward:?}: expected three numbers"),
+            };
+            let n = super::plot::MAX_FIGURES;
+            let frames: Vec<usize> = (0..n)
+                .map(|k| (k * c.len().saturating_sub(1)) / (n - 1))
+                .collect();
+            save_contact_sheet(&c, &frames, &[], fwd, out)?;
+            println!("{}: {} figures of {}", out.display(), n, c.name);
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,339 @@
+//! Feet and the ground: leg chains found automatically, foot contacts detected, and ground
+//! penetration removed with two-bone IK (hip–knee–ankle), raising the root only when a leg
+//! cannot reach.
+//!
+//! Legs: the two leaves lowest in the first frame are the toes; up each toe's chain, the
+//! hip–knee–ankle triple is the pair of consecutive bones with the largest shorter bone (thigh
+//! and shin are the long ones). A foot's points are its ankle and everything below it.
+//! A foot is in contact when its lowest point is within [`CONTACT_HEIGHT`] of the ground and
+//! it moves slower than [`CONTACT_SPEED`] horizontally.
+
+use glam::{Quat, Vec3};
+
+use crate::motion::{Clip, Skeleton};
+
+/// Height above the ground (metres) under which a foot can be in contact.
+pub const CONTACT_HEIGHT: f32 = 0.05;
+/// Horizontal foot speed (m/s) under which a low foot is in contact.
+pub const CONTACT_SPEED: f32 = 0.5;
+/// Ground height, metres.
+pub const GROUND_Y: f32 = 0.0;
+
+/// One leg: joint indices, and the foot's points (ankle and its descendants).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Leg {
+    /// Hip joint (top of the thigh).
+    pub hip: usize,
+    /// Knee joint.
+    pub knee: usize,
+    /// Ankle joint.
+    pub ankle: usize,
+    /// The ankle and every joint below it.
+    pub foot: Vec<usize>,
+}
+
+/// Finds the legs of a skeleton from a clip's first frame (empty if none are found).
+pub fn find_legs(clip: &Clip) -> Vec<Leg> {
+    let sk = &clip.skeleton;
+    let p = clip.joint_positions(0);
+    if p.is_empty() {
+        return Vec::new();
+    }
+    let mut leaves: Vec<usize> = (0..sk.len())
+        .filter(|&j| sk.children(j).is_empty())
+        .collect();
+    leaves.sort_by(|&a, &b| p[a].y.total_cmp(&p[b].y));
+    let mut legs: Vec<Leg> = Vec::new();
+    for leaf in leaves {
+        if legs.len() == 2 {
+            break;
+        }
+        let chain = sk.chain_to(leaf);
+        // chain: root … leaf. Candidate triples (hip, knee, ankle) = chain[k], [k+1], [k+2].
+        let mut best: Option<(usize, f32)> = None;
+        for k in 1..chain.len().saturating_sub(2) {
+            let (a, b, c) = (chain[k], chain[k + 1], chain[k + 2]);
+            let l = (p[b] - p[a]).length().min((p[c] - p[b]).length());
+            if best.is_none_or(|(_, bl)| l > bl) {
+                best = Some((k, l));
+            }
+        }
+        let Some((k, l)) = best else { continue };
+        if l <= 1e-6 {
+            continue;
+        }
+        let (hip, knee, ankle) = (chain[k], chain[k + 1], chain[k + 2]);
+        if legs.iter().any(|g| g.hip == hip || g.ankle == ankle) {
+            continue;
+        }
+        let foot = descendants(sk, ankle);
+        legs.push(Leg {
+            hip,
+            knee,
+            ankle,
+            foot,
+        });
+    }
+    legs
+}
+
+fn descendants(sk: &Skeleton, j: usize) -> Vec<usize> {
+    let mut out = vec![j];
+    let mut i = 0;
+    while i < out.len() {
+        out.extend(sk.children(out[i]));
+        i += 1;
+    }
+    out
+}
+
+/// Per leg, per frame: whether the foot is in contact with the ground.
+pub fn detect_contacts(clip: &Clip, legs: &[Leg]) -> Vec<Vec<bool>> {
+    let pos = clip.all_positions();
+    let dt = clip.frame_time.max(1e-6);
+    legs.iter()
+        .map(|leg| {
+            (0..pos.len())
+                .map(|f| {
+                    let low = leg
+                        .foot
+                        .iter()
+                        .map(|&j| pos[f][j].y)
+                        .fold(f32::INFINITY, f32::min);
+                    let (a, b) = (f.saturating_sub(1), (f + 1).min(pos.len() - 1));
+                    let d = pos[b][leg.ankle] - pos[a][leg.ankle];
+                    let v = Vec3::new(d.x, 0.0, d.z).length() / ((b - a).max(1) as f32 * dt);
+                    low < GROUND_Y + CONTACT_HEIGHT && v < CONTACT_SPEED
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Frames over which a pinned foot eases in and out of its pin.
+pub const PIN_EASE_FRAMES: usize = 3;
+
+/// Pins planted feet: for every run of contact frames of a leg, the ankle is held (in the
+/// ground plane) where it was in the run's middle frame, by two-bone IK, easing in and out
+/// over [`PIN_EASE_FRAMES`] frames; its height stays the animation's. Unreachable pins are
+/// approached as far as the leg allows.
+pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
+    let sk = clip.skeleton.clone();
+    let n = clip.len();
+    for (leg, flags) in legs.iter().zip(contacts) {
+        let mut f = 0;
+        while f < n {
+            if !flags.get(f).copied().unwrap_or(false) {
+                f += 1;
+                continue;
+            }
+            let a = f;
+            while f < n && flags.get(f).copied().unwrap_or(false) {
+                f += 1;
+            }
+            let b = f - 1;
+            if b == a {
+                continue;
+            }
+            let mid = (a + b) / 2;
+            let pin = sk.positions(&clip.frames[mid])[leg.ankle];
+            let lo = a.saturating_sub(PIN_EASE_FRAMES);
+            let hi = (b + PIN_EASE_FRAMES).min(n - 1);
+            for g in lo..=hi {
+                let w = if g < a {
+                    (g + 1 - lo) as f32 / (a + 1 - lo) as f32
+                } else if g > b {
+                    (hi + 1 - g) as f32 / (hi + 1 - b) as f32
+                } else {
+                    1.0
+                };
+                let pose = &mut clip.frames[g];
+                let own = sk.positions(pose)[leg.ankle];
+                let target = Vec3::new(
+                    own.x + (pin.x - own.x) * w,
+                    own.y,
+                    own.z + (pin.z - own.z) * w,
+                );
+                if (target - own).length() > 1e-5 {
+                    two_bone_ik(&sk, pose, leg, target);
+                }
+            }
+        }
+    }
+}
+
+/// What the ground pass changed.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GroundFix {
+    /// Frames where IK bent a leg.
+    pub ik_frames: usize,
+    /// Frames where the root had to be raised.
+    pub raised_frames: usize,
+    /// Deepest penetration found before the fix, metres.
+    pub max_depth: f32,
+}
+
+/// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
+/// cannot reach, the root is raised by what remains.
+pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
+    let mut fix = GroundFix::default();
+    let sk = clip.skeleton.clone();
+    for pose in &mut clip.frames {
+        let mut bent = false;
+        for leg in legs {
+            let world = sk.forward(pose);
+            let low = leg
+                .foot
+                .iter()
+                .map(|&j| world[j].position.y)
+                .fold(f32::INFINITY, f32::min);
+            let depth = GROUND_Y - low;
+            if depth <= 0.0 || !depth.is_finite() {
+                continue;
+            }
+            fix.max_depth = fix.max_depth.max(depth);
+            let target = world[leg.ankle].position + Vec3::Y * (depth + 1e-4);
+            two_bone_ik(&sk, pose, leg, target);
+            bent = true;
+        }
+        // Whatever IK could not reach: raise the whole body.
+        let world = sk.positions(pose);
+        let low = legs
+            .iter()
+            .flat_map(|l| l.foot.iter())
+            .map(|&j| world[j].y)
+            .fold(f32::INFINITY, f32::min);
+        if low < GROUND_Y && low.is_finite() {
+            if let Some(t) = pose.translations.first_mut() {
+                t.y += GROUND_Y - low + 1e-4;
+            }
+            fix.raised_frames += 1;
+        }
+        if bent {
+            fix.ik_frames += 1;
+        }
+    }
+    fix
+}
+
+/// Two-bone IK: rotates hip and knee so the ankle reaches `target` (or as close as the leg
+/// allows), keeping the knee's bending plane and the foot's world orientation.
+pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, target: Vec3) {
+    let world = sk.forward(pose);
+    let (a, b, c) = (
+        world[leg.hip].position,
+        world[leg.knee].position,
+        world[leg.ankle].position,
+    );
+    let (a_gr, b_gr, c_gr) = (
+        world[leg.hip].rotation,
+        world[leg.knee].rotation,
+        world[leg.ankle].rotation,
+    );
+    let lab = (b - a).length();
+    let lcb = (b - c).length();
+    if lab < 1e-6 || lcb < 1e-6 {
+        return;
+    }
+    let eps = 1e-4;
+    let lat = (target - a)
+        .length()
+        .clamp(eps + (lab - lcb).abs(), lab + lcb - eps);
+    let acos = |x: f32| x.clamp(-1.0, 1.0).acos();
+    let ac_ab_0 = acos((c - a).normalize_or_zero().dot((b - a).normalize_or_zero()));
+    let ba_bc_0 = acos((a - b).normalize_or_zero().dot((c - b).normalize_or_zero()));
+    let ac_at_0 = acos(
+        (c - a)
+            .normalize_or_zero()
+            .dot((target - a).normalize_or_zero()),
+    );
+    let ac_ab_1 = acos((lcb * lcb - lab * lab - lat * lat) / (-2.0 * lab * lat));
+    let ba_bc_1 = acos((lat * lat - lab * lab - lcb * lcb) / (-2.0 * lab * lcb));
+    let mut axis0 = (c - a).cross(b - a).normalize_or_zero();
+    if axis0 == Vec3::ZERO {
+        // Straight leg: bend forward, about the hip's own lateral direction.
+        axis0 = (a_gr * Vec3::Z).normalize_or_zero();
+        if axis0 == Vec3::ZERO {
+            return;
+        }
+    }
+    let axis1 = (c - a).cross(target - a).normalize_or_zero();
+    let r0 = Quat::from_axis_angle((a_gr.inverse() * axis0).normalize(), ac_ab_1 - ac_ab_0);
+    let r1 = Quat::from_axis_angle((b_gr.inverse() * axis0).normalize(), ba_bc_1 - ba_bc_0);
+    let r2 = if axis1 == Vec3::ZERO {
+        Quat::IDENTITY
+    } else {
+        Quat::from_axis_angle((a_gr.inverse() * axis1).normalize(), ac_at_0)
+    };
+    pose.rotations[leg.hip] = (pose.rotations[leg.hip] * (r0 * r2)).normalize();
+    pose.rotations[leg.knee] = (pose.rotations[leg.knee] * r1).normalize();
+    // Keep the foot's world orientation.
+    let knee_world = sk.forward(pose)[leg.knee].rotation;
+    pose.rotations[leg.ankle] = (knee_world.inverse() * c_gr).normalize();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::skeleton::{Joint, RotationOrder};
+    use crate::motion::Pose;
+
+    fn leg_clip() -> Clip {
+        let j = |name: &str, parent, offset| Joint {
+            name: name.into(),
+            parent,
+            offset,
+            channels: vec![],
+            rotation_order: RotationOrder::ZYX,
+            end_site: false,
+        };
+        let sk = Skeleton {
+            joints: vec![
+                j("pelvis", None, Vec3::ZERO),
+                j("hip", Some(0), Vec3::new(0.1, 0.0, 0.0)),
+                j("knee", Some(1), Vec3::new(0.0, -0.45, 0.0)),
+                j("ankle", Some(2), Vec3::new(0.0, -0.45, 0.0)),
+                j("toe", Some(3), Vec3::new(0.0, -0.05, 0.12)),
+                j("head", Some(0), Vec3::new(0.0, 0.7, 0.0)),
+            ],
+        };
+        let mut p = Pose::rest(&sk);
+        p.translations[0] = Vec3::new(0.0, 0.9, 0.0); // toe at y = -0.05: 5 cm under ground
+        p.rotations[2] = Quat::from_rotation_x(0.2);
+        Clip {
+            name: "leg".into(),
+            skeleton: sk,
+            frame_time: 1.0 / 30.0,
+            frames: vec![p.clone(), p],
+        }
+    }
+
+    #[test]
+    fn finds_the_leg_and_lifts_the_foot_with_ik() {
+        let mut c = leg_clip();
+        let legs = find_legs(&c);
+        assert_eq!(legs.len(), 1, "{legs:?}");
+        assert_eq!((legs[0].hip, legs[0].knee, legs[0].ankle), (1, 2, 3));
+        let before = c.joint_positions(0);
+        let fix = fix_ground(&mut c, &legs);
+        let after = c.joint_positions(0);
+        assert!(fix.max_depth > 0.0 && fix.ik_frames == 2, "{fix:?}");
+        assert!(after[4].y >= -1e-5 && after[3].y >= -1e-5, "{after:?}");
+        // The pelvis did not move: IK alone did it (the bent knee has slack).
+        assert!((after[0] - before[0]).length() < 1e-6);
+        assert_eq!(fix.raised_frames, 0);
+    }
+
+    #[test]
+    fn unreachable_targets_raise_the_root() {
+        let mut c = leg_clip();
+        for p in &mut c.frames {
+            p.translations[0].y = -1.5; // hip 1.5 m under ground: the leg cannot reach
+        }
+        let legs = find_legs(&c);
+        let fix = fix_ground(&mut c, &legs);
+        assert_eq!(fix.raised_frames, 2);
+        let p = c.joint_positions(1);
+        assert!(p[3].y >= -1e-4 && p[4].y >= -1e-4, "{p:?}");
+    }
+}

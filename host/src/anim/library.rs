@@ -1,0 +1,377 @@
+//! The clip library: which motion clip plays each recognised action, and how.
+//!
+//! A JSON file maps action names to clips:
+//! ```json
+//! { "version": 1,
+//!   "skeleton": { "format": "deepmimic-urdf", "file": "deepmimic/humanoid.urdf" },
+//!   "forward": [1, 0, 0],
+//!   "actions": {
+//!     "walk":  { "file": "deepmimic/humanoid3d_walk.txt", "moving": true, "cyclic": true },
+//!     "bow":   { "file": "deepmimic/humanoid3d_getup_facedown.txt", "moving": false,
+//!                "cyclic": false, "frames": [150, 182], "pingpong": true, "note": "…" } } }
+//! ```
+//! `moving` actions follow the doodle's path, others play in place (§6.2); `cyclic` actions
+//! repeat whole cycles along the path. `frames` picks an inclusive frame range, `pingpong`
+//! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
+//! `scale` turns a BVH clip's unit into metres (default
+//! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces in its clips.
+//! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
+//! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
+//! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
+//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::Deserialize;
+
+use super::AnimError;
+use crate::motion::deepmimic::{humanoid_skeleton, read_deepmimic};
+use crate::motion::urdf::read_urdf_path;
+use crate::motion::{read_bvh_path, Clip, Skeleton};
+
+/// The built-in default library text.
+pub const DEFAULT_LIBRARY: &str = include_str!("../../assets/default_clips.json");
+
+/// How one action is played.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActionSpec {
+    /// Clip file: relative to the library, or `KIND/NAME` in the data folder.
+    pub file: String,
+    /// Whether the character travels along the doodle (false: in place, §6.2).
+    pub moving: bool,
+    /// Whether the clip is one cycle of a repeating motion (walk, run).
+    pub cyclic: bool,
+    /// Inclusive frame range of the source clip to use.
+    #[serde(default)]
+    pub frames: Option<[usize; 2]>,
+    /// Play the range backwards, then forwards (e.g. a rise played as down-and-up).
+    #[serde(default)]
+    pub pingpong: bool,
+    /// In-place actions only: remove the clip's net ground drift (linearly over the clip) so
+    /// the character ends where it started, as the seed's in-place rule has it. For clips
+    /// that travel although their action should not (DeepMimic's spin); feet slide a little.
+    #[serde(default)]
+    pub anchor: bool,
+    /// Length unit → metres for BVH clips (default 0.01).
+    #[serde(default)]
+    pub scale: Option<f32>,
+    /// Why this clip was chosen (substitutions are documented here).
+    #[serde(default)]
+    pub note: Option<String>,
+}
+
+/// Where the skeleton of DeepMimic clips comes from.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkeletonSpec {
+    /// `deepmimic-urdf` (the only format that needs a separate skeleton file).
+    pub format: String,
+    /// The URDF file (same resolution rules as clips).
+    pub file: String,
+}
+
+/// A parsed clip-library file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClipLibrary {
+    /// Format version (1).
+    pub version: u32,
+    /// Skeleton source for DeepMimic clips.
+    #[serde(default)]
+    pub skeleton: Option<SkeletonSpec>,
+    /// Direction the rig faces in its clips (rig space, horizontal).
+    #[serde(default = "default_forward")]
+    pub forward: [f32; 3],
+    /// Action name → clip.
+    pub actions: BTreeMap<String, ActionSpec>,
+    /// Folder relative paths resolve against (the library file's folder).
+    #[serde(skip)]
+    pub base: Option<PathBuf>,
+    /// Name used in messages (file path or "default clip library").
+    #[serde(skip)]
+    pub origin: String,
+}
+
+fn default_forward() -> [f32; 3] {
+    [1.0, 0.0, 0.0]
+}
+
+/// A clip ready for assembly.
+#[derive(Debug, Clone)]
+pub struct ActionClip {
+    /// Action name.
+    pub action: String,
+    /// The clip in metres, +Y up.
+    pub clip: Clip,
+    /// Travels along the doodle.
+    pub moving: bool,
+    /// Repeats in cycles.
+    pub cyclic: bool,
+    /// In place and anchored: the clip's net ground drift is removed.
+    pub anchor: bool,
+}
+
+impl ClipLibrary {
+    /// The built-in default library.
+    pub fn default_library() -> Result<ClipLibrary, AnimError> {
+        Self::parse(DEFAULT_LIBRARY, Path::new("default clip library"), None)
+    }
+
+    /// Reads a library file.
+    pub fn read_path(path: &Path) -> Result<ClipLibrary, AnimError> {
+        let text = std::fs::read_to_string(path).map_err(|e| AnimError::Io {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        Self::parse(&text, path, path.parent().map(Path::to_path_buf))
+    }
+
+    /// Parses library JSON; errors name `name` and the line.
+    pub fn parse(text: &str, name: &Path, base: Option<PathBuf>) -> Result<ClipLibrary, AnimError> {
+        let mut lib: ClipLibrary = serde_json::from_str(text).map_err(|e| AnimError::Spec {
+            path: name.to_path_buf(),
+            line: e.line().max(1),
+            reason: e.to_string(),
+        })?;
+        if lib.version != 1 {
+            return Err(AnimError::Spec {
+                path: name.to_path_buf(),
+                line: 1,
+                reason: format!("unsupported clip-library version {}", lib.version),
+            });
+        }
+        lib.base = base;
+        lib.origin = name.display().to_string();
+        Ok(lib)
+    }
+
+    /// Facing direction of the rig (unit, horizontal).
+    pub fn forward(&self) -> Vec3 {
+        let f = Vec3::from(self.forward);
+        let f = Vec3::new(f.x, 0.0, f.z);
+        if f.length() > 1e-6 {
+            f.normalize()
+        } else {
+            Vec3::X
+        }
+    }
+
+    /// Checks that every action has a clip; the error lists all missing mappings.
+    pub fn check_actions<'a>(
+        &self,
+        actions: impl IntoIterator<Item = &'a str>,
+    ) -> Result<(), AnimError> {
+        let mut missing: Vec<String> = actions
+            .into_iter()
+            .filter(|a| !self.actions.contains_key(*a))
+            .map(str::to_string)
+            .collect();
+        missing.sort();
+        missing.dedup();
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(AnimError::MissingClips {
+                library: self.origin.clone(),
+                missing,
+                available: self.actions.keys().cloned().collect(),
+            })
+        }
+    }
+
+    /// Finds a file named in the library.
+    pub fn resolve(&self, file: &str) -> Result<PathBuf, AnimError> {
+        if let Some(base) = &self.base {
+            let p = base.join(file);
+            if p.is_file() {
+                return Ok(p);
+            }
+        }
+        let p = Path::new(file);
+        if p.is_absolute() && p.is_file() {
+            return Ok(p.to_path_buf());
+        }
+        if let Some((kind, name)) = file.split_once('/') {
+            if let Some(p) = crate::data::data_file(kind, name) {
+                return Ok(p);
+            }
+        }
+        Err(AnimError::Data(format!(
+            "clip file {file} (named in {}) not found next to the library nor under {}: run \
+             `cargo xtask setup` to fetch the data (or set {})",
+            self.origin,
+            crate::data::data_dir().display(),
+            crate::data::DATA_DIR_ENV
+        )))
+    }
+
+    fn skeleton_urdf(
+        &self,
+    ) -> Result<Option<(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>, AnimError> {
+        let Some(spec) = &self.skeleton else {
+            return Ok(None);
+        };
+        if spec.format != "deepmimic-urdf" {
+            return Err(AnimError::Data(format!(
+                "{}: unknown skeleton format {:?}",
+                self.origin, spec.format
+            )));
+        }
+        let path = self.resolve(&spec.file)?;
+        let urdf = read_urdf_path(&path)?;
+        let sk = humanoid_skeleton(&urdf, &path)?;
+        Ok(Some((sk, urdf)))
+    }
+
+    /// Loads the clips of the given actions (all must be mapped, see [`Self::check_actions`]).
+    pub fn load<'a>(
+        &self,
+        actions: impl IntoIterator<Item = &'a str>,
+    ) -> Result<BTreeMap<String, ActionClip>, AnimError> {
+        let wanted: Vec<&str> = actions.into_iter().collect();
+        self.check_actions(wanted.iter().copied())?;
+        let urdf = self.skeleton_urdf()?;
+        let mut out = BTreeMap::new();
+        let mut names: Option<Vec<String>> = None;
+        for action in wanted {
+            if out.contains_key(action) {
+                continue;
+            }
+            let Some(spec) = self.actions.get(action) else {
+                continue;
+            };
+            let path = self.resolve(&spec.file)?;
+            let mut clip = if path
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
+            {
+                let mut c = read_bvh_path(&path)?.clip;
+                c.scale_lengths(spec.scale.unwrap_or(0.01));
+                c
+            } else {
+                let (sk, u) = urdf.as_ref().ok_or_else(|| {
+                    AnimError::Data(format!(
+                        "{}: DeepMimic clip {} needs a \"skeleton\" entry",
+                        self.origin, spec.file
+                    ))
+                })?;
+                let text = std::fs::read_to_string(&path).map_err(|e| AnimError::Io {
+                    path: path.clone(),
+                    reason: e.to_string(),
+                })?;
+                let mut c = read_deepmimic(&text, &path, sk, u)?.clip;
+                c.scale_lengths(spec.scale.unwrap_or(1.0));
+                c
+            };
+            clip.name = action.to_string();
+            select_frames(&mut clip, spec, &self.origin, action)?;
+            let joint_names: Vec<String> = clip
+                .skeleton
+                .joints
+                .iter()
+                .map(|j| j.name.clone())
+                .collect();
+            match &names {
+                None => names = Some(joint_names),
+                Some(n) if *n != joint_names => {
+                    return Err(AnimError::Data(format!(
+                        "{}: clip for {action} ({}) has a different skeleton from the other clips",
+                        self.origin, spec.file
+                    )))
+                }
+                Some(_) => {}
+            }
+            out.insert(
+                action.to_string(),
+                ActionClip {
+                    action: action.to_string(),
+                    clip,
+                    moving: spec.moving,
+                    cyclic: spec.cyclic,
+                    anchor: spec.anchor && !spec.moving,
+                },
+            );
+        }
+        Ok(out)
+    }
+}
+
+fn select_frames(
+    clip: &mut Clip,
+    spec: &ActionSpec,
+    origin: &str,
+    action: &str,
+) -> Result<(), AnimError> {
+    if let Some([a, b]) = spec.frames {
+        if a >= b || b >= clip.frames.len() {
+            return Err(AnimError::Data(format!(
+                "{origin}: action {action}: frame range [{a}, {b}] is not inside the clip's {} frames",
+                clip.frames.len()
+            )));
+        }
+        clip.frames = clip.frames[a..=b].to_vec();
+    }
+    if spec.pingpong {
+        let mut seq: Vec<_> = clip.frames.iter().rev().cloned().collect();
+        seq.extend(clip.frames.iter().skip(1).cloned());
+        clip.frames = seq;
+    }
+    if clip.frames.len() < 2 {
+        return Err(AnimError::Data(format!(
+            "{origin}: action {action}: clip has fewer than 2 frames"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_library_maps_the_default_actions() {
+        let lib = ClipLibrary::default_library().unwrap();
+        let defaults = [
+            "walk", "run", "jump", "punch", "throw", "kick", "turn", "sidestep", "crouch", "bow",
+            "wave", "spin",
+        ];
+        lib.check_actions(defaults).unwrap();
+        let err = lib
+            .check_actions(["walk", "moonwalk", "fly", "fly"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("no clip for action(s) fly, moonwalk in"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn malformed_library_names_file_and_line() {
+        let text = "{\n\"version\": 1,\n\"actions\": {\n\"walk\": {\"file\": 3}\n}\n}";
+        let err = ClipLibrary::parse(text, Path::new("lib.json"), None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("lib.json:4:"), "{err}");
+    }
+
+    #[test]
+    fn default_clips_load_with_one_skeleton() {
+        if crate::data::data_file("deepmimic", "humanoid.urdf").is_none() {
+            eprintln!("skipping: deepmimic data missing — run `cargo xtask setup`");
+            return;
+        }
+        let lib = ClipLibrary::default_library().unwrap();
+        let names: Vec<String> = lib.actions.keys().cloned().collect();
+        let clips = lib.load(names.iter().map(String::as_str)).unwrap();
+        assert_eq!(clips.len(), 12);
+        let crouch = &clips["crouch"].clip;
+        // Ping-pong: starts and ends on the same (standing) pose.
+        let (a, b) = (&crouch.frames[0], &crouch.frames[crouch.len() - 1]);
+        assert_eq!(a, b);
+    }
+}

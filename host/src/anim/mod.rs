@@ -1,0 +1,66 @@
+//! Animation assembly (seed 000 §6): from recognised actions, their Laban efforts and the
+//! doodle's path to a full-body character animation.
+//!
+//! Data flow, one file per stage:
+//! [`library`] (action → clip) → [`phrasing`] (stages of each clip, §6.1) →
+//! [`effort`] (retime eq. 6, rescale eq. 7, weight arc length, reshape; §6.3–6.4) →
+//! [`trajectory`] (doodle → ground path, in-place offsets, cycles, jumps; §6.2) →
+//! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
+//! [`contact`] (foot contacts, two-bone IK against ground penetration) →
+//! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages`).
+//! [`plot`] draws contact sheets to look at the result.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+use crate::motion::MotionError;
+
+pub mod assemble;
+pub mod cli;
+pub mod contact;
+pub mod effort;
+pub mod library;
+pub mod phrasing;
+pub mod plot;
+pub mod trajectory;
+pub mod transition;
+
+/// Why an animation could not be assembled.
+#[derive(Debug, Error)]
+pub enum AnimError {
+    /// Reading or writing motion data failed.
+    #[error(transparent)]
+    Motion(#[from] MotionError),
+    /// A file could not be read or written.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// A clip-library (or effort) file is malformed.
+    #[error("{path}:{line}: {reason}")]
+    Spec {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Some recognised actions have no clip in the library.
+    #[error("no clip for action(s) {} in {library} (it maps: {})", missing.join(", "), available.join(", "))]
+    MissingClips {
+        /// The library's file name.
+        library: String,
+        /// Actions without a mapping, sorted.
+        missing: Vec<String>,
+        /// Actions the library does map.
+        available: Vec<String>,
+    },
+    /// Data is missing or inconsistent.
+    #[error("{0}")]
+    Data(String),
+}

@@ -1,0 +1,92 @@
+//! Style-coherent motion graphs (seed 003, Aristidou et al. 2017).
+//!
+//! Data flow, one file per stage:
+//! - [`roles`]: which joint of any rig is the hips, head, hands, feet … (names + override file).
+//! - [`source`]: clips loaded from BVH / DeepMimic, resampled to 30 fps, role points in
+//!   height-normalised metres.
+//! - [`lma`]: the 29 LMA features of Table 1 → 114 measurements per 35-frame window.
+//! - [`posture`]: eq. 1, Kovar's posture distance with the closed-form 2-D alignment.
+//! - [`style`]: eq. 2, Pearson style correlation per LMA component, weights, Gaussian smoothing.
+//! - [`build`]: the tiled, multi-core, streaming O(N²) candidate search (never an N×N matrix).
+//! - [`graph`]: nodes, transition edges, blends, strongly connected trimming, the file format.
+//! - [`synth`]: synthesis by highest similarity (§5.3) and by example (§5.4).
+//! - [`effort`]: Laban Effort (Lt, Lw) from the Effort-component measurements, for choosing
+//!   clip variants and transitions by a recognised effort.
+//! - [`eval`]: the paper's §5.2–5.3 evaluation (label costs, transition counts).
+//! - [`cli`]: `figurine graph build | synth | eval`.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+pub mod build;
+pub mod cli;
+pub mod effort;
+pub mod eval;
+#[allow(clippy::module_inception)]
+pub mod graph;
+pub mod lma;
+pub mod posture;
+pub mod roles;
+pub mod source;
+pub mod style;
+pub mod synth;
+
+pub use build::{build_graph, BuildParams};
+pub use graph::{Edge, MotionGraph, Variant};
+pub use roles::{Role, RoleMap};
+pub use source::{load_clip, GraphClip};
+
+/// Frames per second every clip is resampled to (the paper's capture rate).
+pub const FPS: f32 = 30.0;
+/// Frames in one analysis window (Table 1's 35-frame window at 30 fps).
+pub const WINDOW: usize = 35;
+/// Frames on each side of a window's centre frame.
+pub const HALF: usize = WINDOW / 2;
+
+/// Why a motion-graph step failed.
+#[derive(Debug, Error)]
+pub enum GraphError {
+    /// A motion file could not be read (the message names the file).
+    #[error(transparent)]
+    Motion(#[from] crate::motion::MotionError),
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file's content is malformed (graph file, role override, labels …).
+    #[error("{path}: {reason}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A skeleton lacks a joint for a role and no override names one.
+    #[error("{clip}: no joint found for role `{role}` (joints: {joints}); name it in a role override file (--roles ROLES.json)")]
+    MissingRole {
+        /// The clip.
+        clip: String,
+        /// The role name.
+        role: &'static str,
+        /// The skeleton's joint names, comma-separated.
+        joints: String,
+    },
+    /// The request cannot be served (no usable clips, empty graph …).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl GraphError {
+    /// A format error for `path`.
+    pub fn format(path: impl Into<PathBuf>, reason: impl Into<String>) -> GraphError {
+        GraphError::Format {
+            path: path.into(),
+            reason: reason.into(),
+        }
+    }
+}
