@@ -3,10 +3,15 @@
 //! * `setup` — installs what a fresh Debian machine needs (idempotent).
 //! * `test` — setup, then every check: fmt, clippy, host tests, no_std checks for the thumb
 //!   target, firmware builds for every board, end-to-end tests.
+//! * `demo` — the main job: a doodle recognised, animated, rendered (target/demo/).
+//! * `bench` — prints every figure (sizes, speed, accuracy, instructions, render, graph).
+//! * `e2e` — the firmware in QEMU against the host.
 //! * `firmware --board qemu|nrf52840` — builds the firmware binary.
 //! * `fuzz --seconds N` — runs every cargo-fuzz target for N seconds (nightly).
 
+mod bench;
 mod data;
+mod demo;
 mod setup;
 mod tasks;
 mod util;
@@ -25,6 +30,13 @@ struct Cli {
 enum Cmd {
     /// Install the Rust target, Debian packages, validators and real data (idempotent).
     Setup,
+    /// The main job: a doodle recognised, animated and rendered (writes target/demo/).
+    Demo,
+    /// Print every figure: wire sizes, recognizer speed and accuracy, firmware size,
+    /// instructions and latency, render and motion-graph build times.
+    Bench,
+    /// Build the QEMU firmware and run the end-to-end tests against it.
+    E2e,
     /// Fetch only the real motion data into target/figurine-data.
     Data,
     /// Run every check and test (calls setup first).
@@ -51,6 +63,9 @@ fn main() -> anyhow::Result<()> {
     match cli.command {
         Cmd::Setup => setup::setup(),
         Cmd::Data => data::fetch(),
+        Cmd::Demo => demo::demo().map(|_| ()),
+        Cmd::Bench => bench::bench(),
+        Cmd::E2e => tasks::e2e(),
         Cmd::Test => tasks::test(),
         Cmd::Firmware { board, debug } => tasks::firmware(board, !debug),
         Cmd::Fuzz { seconds } => tasks::fuzz(seconds),

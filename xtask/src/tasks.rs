@@ -17,6 +17,16 @@ pub enum Board {
 }
 
 impl Board {
+    /// Cargo target folder of this board's build (inside `firmware/app/`): the QEMU image stays
+    /// at cargo's default place, where the end-to-end tests look; the nRF52840 build gets its
+    /// own folder so building one board never overwrites the other's image.
+    fn target_dir(self) -> &'static str {
+        match self {
+            Board::Qemu => "target",
+            Board::Nrf52840 => "target/nrf52840",
+        }
+    }
+
     fn feature(self) -> &'static str {
         match self {
             Board::Qemu => "qemu",
@@ -29,6 +39,7 @@ impl Board {
 const NO_STD_CRATES: &[(&str, &str)] = &[
     ("figurine-protocol", "defmt"),
     ("figurine-recognizer", "defmt"),
+    ("figurine-store", "defmt"),
 ];
 
 /// Builds the firmware for one board.
@@ -46,6 +57,17 @@ pub fn firmware(board: Board, release: bool) -> Result<()> {
         cmd.arg("--release");
     }
     run(&mut cmd)
+}
+
+/// The end-to-end tests: the real firmware in QEMU against the host.
+pub fn e2e() -> Result<()> {
+    crate::setup::setup()?;
+    firmware(Board::Qemu, true)?;
+    step("end-to-end tests (figurine-e2e)");
+    let (passed, failed) =
+        run_tests(cargo().args(["test", "-p", "figurine-e2e", "--no-fail-fast"]))?;
+    println!("tests: {passed} passed, {failed} failed");
+    Ok(())
 }
 
 /// Everything CI checks.
@@ -91,6 +113,8 @@ pub fn test() -> Result<()> {
                     "--no-default-features",
                     "--features",
                     board.feature(),
+                    "--target-dir",
+                    board.target_dir(),
                     "--",
                     "-D",
                     "warnings",

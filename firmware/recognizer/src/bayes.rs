@@ -26,7 +26,7 @@ use crate::Error;
 pub const MAX_EFFORT_FEATURES: usize = 16;
 /// Effort blob format version.
 pub const EFFORT_VERSION: u8 = 1;
-/// Largest valid effort blob, bytes (562).
+/// Largest valid effort blob, bytes (558).
 pub const MAX_EFFORT_BYTES: usize =
     4 + 2 * (1 + MAX_EFFORT_FEATURES + 4 + 16 * MAX_EFFORT_FEATURES);
 /// Smallest variance accepted, to keep likelihoods finite.
@@ -218,5 +218,14 @@ mod tests {
         let mut b = bytes.clone();
         b[6..10].copy_from_slice(&f32::NAN.to_le_bytes()); // the Time prior
         assert!(EffortModel::from_bytes(&b).is_err());
+    }
+}
+
+#[cfg(test)]
+mod sizes {
+    #[test]
+    fn documented_blob_limits() {
+        assert_eq!(super::MAX_EFFORT_BYTES, 558);
+        assert_eq!(crate::pattern::MAX_LIBRARY_BYTES, 11_656);
     }
 }

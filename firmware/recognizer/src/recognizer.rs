@@ -3,16 +3,19 @@
 //! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 10.3 KiB, automata 1 KiB,
-//! effort model 0.6 KiB — about 12 KiB in all with 32 actions loaded.
+//! effort model 0.6 KiB, a held cyclic event 0.2 KiB — 12.4 KiB in all (`size_of`, measured by
+//! a test) with 32 actions loaded.
 
 use crate::automaton::{earliest_start, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::features::segment_features;
+use crate::features::{segment_features, Accum};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::pattern::{Library, MAX_ACTIONS};
-use crate::segment::{Candidate, Decider, Decision, LONG_PAUSE_US};
+use crate::segment::{
+    Candidate, Decider, Decision, CYCLIC_PAUSE_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS,
+};
 use crate::token::{Token, STILL};
 
 /// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
@@ -59,6 +62,17 @@ pub struct Stats {
     pub events: u32,
 }
 
+/// A committed cyclic action not yet emitted: the next hop of a walk may still join it.
+#[derive(Debug, Clone, Copy)]
+struct Held {
+    action: u8,
+    start: (u32, u64),
+    end: (u32, u64),
+    end_run: u32,
+    distance: u8,
+    acc: Accum,
+}
+
 /// The online recognizer over a borrowed library blob (e.g. in flash).
 #[derive(Debug, Clone)]
 pub struct Recognizer<'lib> {
@@ -72,6 +86,7 @@ pub struct Recognizer<'lib> {
     events: u32,
     now_us: u64,
     now_seq: u32,
+    held: Option<Held>,
 }
 
 impl<'lib> Recognizer<'lib> {
@@ -88,6 +103,7 @@ impl<'lib> Recognizer<'lib> {
             events: 0,
             now_us: 0,
             now_seq: 0,
+            held: None,
         }
     }
 
@@ -151,7 +167,8 @@ impl<'lib> Recognizer<'lib> {
         }
         // Stillness: commit after a short pause, forget partial matches after a long one.
         let hist = self.front.history();
-        if let Some(r) = hist.newest().and_then(|i| hist.get(i)) {
+        let newest = hist.newest();
+        if let Some(r) = newest.and_then(|i| hist.get(i)) {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
                 if let Decision::Commit(c) = self.decider.stillness(still) {
@@ -159,8 +176,38 @@ impl<'lib> Recognizer<'lib> {
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
                 }
+                if still >= CYCLIC_PAUSE_US {
+                    self.release(&mut emit);
+                }
             }
         }
+        // A held cyclic action is released once the figurine has clearly moved on.
+        if let (Some(h), Some(n)) = (self.held, newest) {
+            if n.wrapping_sub(h.end_run) > 2 * u32::from(LOOKAHEAD_TOKENS) {
+                self.release(&mut emit);
+            }
+        }
+    }
+
+    fn release(&mut self, emit: &mut impl FnMut(ActionEvent)) {
+        let Some(h) = self.held.take() else { return };
+        let (lt, lw) = match &self.effort {
+            Some(m) => m.classify(&segment_features(&h.acc)),
+            None => (0.0, 0.0),
+        };
+        emit(ActionEvent {
+            action: h.action,
+            start_seq: h.start.0,
+            start_us: h.start.1,
+            end_seq: h.end.0,
+            end_us: h.end.1,
+            time_q: quantise(lt),
+            weight_q: quantise(lw),
+            distance: h.distance,
+            decided_seq: self.now_seq,
+            decided_us: self.now_us,
+        });
+        self.events = self.events.saturating_add(1);
     }
 
     /// Commits the pending candidate, if any (end of stream).
@@ -168,6 +215,7 @@ impl<'lib> Recognizer<'lib> {
         if let Some(c) = self.decider.pending() {
             self.commit(c, &mut emit);
         }
+        self.release(&mut emit);
     }
 
     /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.
@@ -253,32 +301,79 @@ impl<'lib> Recognizer<'lib> {
         best
     }
 
+    /// Commits a candidate: emits it — or, for a cyclic action, holds it so that the next
+    /// cycle of the same action, following after at most a short pause, extends it.
     fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
         let hist = self.front.history();
         let start = hist.get(c.start).map(|r| r.start);
         let end = hist.get(c.end).map(|r| r.end);
-        if let (Some(start), Some(end)) = (start, end) {
-            let (lt, lw) = match &self.effort {
-                Some(m) => m.classify(&segment_features(&hist.accum(c.start, c.end))),
-                None => (0.0, 0.0),
-            };
-            emit(ActionEvent {
-                action: c.action,
-                start_seq: start.0,
-                start_us: start.1,
-                end_seq: end.0,
-                end_us: end.1,
-                time_q: quantise(lt),
-                weight_q: quantise(lw),
-                distance: c.distance,
-                decided_seq: self.now_seq,
-                decided_us: self.now_us,
-            });
-            self.events = self.events.saturating_add(1);
+        // Effort is read over the whole motion phrase around the match — out to the stillness
+        // on either side (not before the previous commit) — as in training, where a gesture's
+        // features span all of its motion.
+        let mut from = c.start;
+        for _ in 0..HISTORY_RUNS {
+            let prev = from.wrapping_sub(1);
+            if prev.wrapping_sub(self.floor) > c.start.wrapping_sub(self.floor) {
+                break;
+            }
+            match hist.get(prev) {
+                Some(r) if r.token != STILL => from = prev,
+                _ => break,
+            }
         }
+        let mut to = c.end;
+        if let Some(newest) = hist.newest() {
+            for _ in 0..HISTORY_RUNS {
+                if to == newest {
+                    break;
+                }
+                match hist.get(to.wrapping_add(1)) {
+                    Some(r) if r.token != STILL => to = to.wrapping_add(1),
+                    _ => break,
+                }
+            }
+        }
+        let acc = hist.accum(from, to);
+        // Only STILL runs between the held action and this one?
+        let contiguous = self.held.is_some_and(|h| {
+            let mut i = h.end_run.wrapping_add(1);
+            let mut ok = true;
+            for _ in 0..HISTORY_RUNS {
+                if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
+                    break;
+                }
+                ok &= hist.get(i).is_some_and(|r| r.token == STILL);
+                i = i.wrapping_add(1);
+            }
+            ok
+        });
         self.bank.reset();
         self.decider.clear();
         self.floor = c.end.wrapping_add(1);
+        let (Some(start), Some(end)) = (start, end) else {
+            return;
+        };
+        match &mut self.held {
+            Some(h) if h.action == c.action && contiguous => {
+                h.end = end;
+                h.end_run = c.end;
+                h.distance = h.distance.max(c.distance);
+                h.acc.merge(&acc);
+                return;
+            }
+            _ => self.release(emit),
+        }
+        self.held = Some(Held {
+            action: c.action,
+            start,
+            end,
+            end_run: c.end,
+            distance: c.distance,
+            acc,
+        });
+        if !c.cyclic {
+            self.release(emit);
+        }
     }
 }
 

@@ -20,7 +20,7 @@ pub const LOOKAHEAD_TOKENS: u8 = 4;
 pub const PAUSE_US: u64 = 120_000;
 /// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
 /// pauses briefly between hops without ending.
-pub const CYCLIC_PAUSE_US: u64 = 300_000;
+pub const CYCLIC_PAUSE_US: u64 = 260_000;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
 pub const LONG_PAUSE_US: u64 = 2_500_000;
 

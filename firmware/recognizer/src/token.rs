@@ -52,7 +52,7 @@ pub const REL_ACTIVE: f32 = 0.10;
 /// Time constant of the decaying peak, seconds.
 pub const PEAK_TAU_S: f32 = 1.0;
 /// Lever arm (m): translation below `ARM_M × |ω|` during rotation is ignored.
-pub const ARM_M: f32 = 0.03;
+pub const ARM_M: f32 = 0.1;
 /// Minimum duration of a token, µs.
 pub const MIN_TOKEN_US: u64 = 40_000;
 /// Rotation angle (rad, ≈ 229°) about one axis, in one direction, after which the current run

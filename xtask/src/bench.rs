@@ -1,0 +1,71 @@
+//! `cargo xtask bench`: every figure the issues ask for, printed (nothing here is a test).
+
+use anyhow::Result;
+
+use crate::util::{cargo, run, step};
+
+/// Runs every benchmark in turn, each printing its own figures with its command.
+pub fn bench() -> Result<()> {
+    crate::setup::setup()?;
+
+    step("wire sizes: cargo run -p figurine-protocol --example sizes");
+    run(cargo().args(["run", "-q", "-p", "figurine-protocol", "--example", "sizes"]))?;
+
+    step("recognizer on the host: cargo bench -p figurine-host --bench recognizer");
+    run(cargo().args(["bench", "-p", "figurine-host", "--bench", "recognizer"]))?;
+
+    step("recognition accuracy: figurine eval (fresh seed, each action learnt from 3 examples)");
+    run(cargo().args([
+        "run",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--bin",
+        "figurine",
+        "--",
+        "eval",
+    ]))?;
+
+    step("firmware: sizes, instructions per sample, latency, sustained rate");
+    crate::tasks::firmware(crate::tasks::Board::Qemu, true)?;
+    crate::tasks::firmware(crate::tasks::Board::Nrf52840, true)?;
+    run(cargo().args([
+        "test",
+        "-q",
+        "-p",
+        "figurine-e2e",
+        "--release",
+        "--test",
+        "bench",
+        "--",
+        "--ignored",
+        "--nocapture",
+        "--test-threads",
+        "1",
+    ]))?;
+
+    step("render: 30 s at 30 fps, 1280x720 (cargo run --release -p figurine-host --example render_bench)");
+    run(cargo().args([
+        "run",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--example",
+        "render_bench",
+    ]))?;
+
+    step("motion graph build at ~10k/27k/54k frames (cargo run --release -p figurine-host --example graph_bench)");
+    run(cargo().args([
+        "run",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--example",
+        "graph_bench",
+    ]))?;
+
+    Ok(())
+}
