@@ -6,7 +6,8 @@
 //! Measures three things on the procedural walking figure (with doodle and timeline):
 //! render + readback only, then the same with GIF encoding and with MP4 encoding to a temp
 //! folder (the MP4 figure only when ffmpeg is installed). A fourth argument writes one
-//! frame as a PNG to look at.
+//! frame as a PNG to look at; `FIGURINE_BENCH_RENDER_ONLY=1` skips the encoding runs. The CPU
+//! time printed is the fair figure on a shared machine (lavapipe renders on the CPU).
 
 use std::time::Instant;
 
@@ -15,6 +16,18 @@ use figurine_host::render::procedural::{walking_scene, FigureParams};
 use figurine_host::render::video::{
     ffmpeg_available, render_frames, render_still, render_to_path, RenderOptions,
 };
+
+/// CPU seconds (user + system) this process has used so far, from `/proc/self/stat` (Linux;
+/// assumes the usual 100 clock ticks per second). `None` elsewhere.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -39,6 +52,7 @@ fn main() -> anyhow::Result<()> {
     }
     // Warm-up: shader compilation and first-frame allocations.
     render_still(&mut r, &scene, 0.0)?;
+    let cpu0 = cpu_seconds();
     let start = Instant::now();
     let mut n = 0;
     let spent = render_frames(&mut r, &scene, fps, |_, _, _| {
@@ -52,6 +66,21 @@ fn main() -> anyhow::Result<()> {
         spent * 1000.0 / n as f64,
         n as f64 / wall
     );
+    if let (Some(a), Some(b)) = (cpu0, cpu_seconds()) {
+        println!(
+            "render+readback CPU time (all threads, lavapipe included): {:.2} s ({:.1} ms/frame); \
+             machine load average {}",
+            b - a,
+            (b - a) * 1000.0 / n as f64,
+            std::fs::read_to_string("/proc/loadavg")
+                .ok()
+                .and_then(|s| s.split_whitespace().next().map(str::to_string))
+                .unwrap_or_else(|| "n/a".into())
+        );
+    }
+    if std::env::var_os("FIGURINE_BENCH_RENDER_ONLY").is_some() {
+        return Ok(());
+    }
     let dir = std::env::temp_dir().join("figurine-render-bench");
     let opts = RenderOptions {
         width: w,

@@ -140,6 +140,94 @@ impl MotionGraph {
     }
 }
 
+/// A transition between two source clips, in seconds of each clip (rate-independent).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClipCut {
+    /// Time in the clip left, seconds from its start.
+    pub from_time: f32,
+    /// Time in the clip joined, seconds from its start (playback continues after it).
+    pub to_time: f32,
+    /// Posture correlation ∈ [0, 1].
+    pub posture: f32,
+    /// Style similarity ∈ [0, 1].
+    pub style: f32,
+    /// Match between the wanted effort and the destination window's effort ∈ [0, 1] (0 if none
+    /// was asked for).
+    pub effort_match: f32,
+}
+
+impl MotionGraph {
+    /// Index of the clip whose name (file stem) or recorded path is `key`.
+    pub fn clip_index(&self, key: &str) -> Option<usize> {
+        self.clips
+            .iter()
+            .position(|c| c.name == key || c.path == key)
+            .or_else(|| {
+                let stem = std::path::Path::new(key)
+                    .file_stem()?
+                    .to_string_lossy()
+                    .into_owned();
+                let stem = stem
+                    .strip_prefix("humanoid3d_")
+                    .unwrap_or(&stem)
+                    .to_string();
+                self.clips.iter().position(|c| c.name == stem)
+            })
+    }
+
+    /// The best transition from clip `from` (leaving between `from_window` seconds of it) to
+    /// clip `to` (joining between `to_window` seconds), scored like [`MotionGraph::best_transition`].
+    /// For an animation assembler: ranges are in seconds of the source clips.
+    pub fn best_cut_between(
+        &self,
+        transitions: &[Vec<Transition>],
+        (from, from_window): (usize, Range<f32>),
+        (to, to_window): (usize, Range<f32>),
+        effort: Option<Effort>,
+        variant: Variant,
+    ) -> Option<ClipCut> {
+        let (a, b) = (self.clips.get(from)?, self.clips.get(to)?);
+        let frame = |c: &super::graph::ClipEntry, t: f32| -> u32 {
+            let f = (t * super::FPS)
+                .round()
+                .clamp(0.0, c.frames.saturating_sub(1) as f32);
+            c.start + f as u32
+        };
+        let (fa0, fa1) = (frame(a, from_window.start), frame(a, from_window.end));
+        let (fb0, fb1) = (frame(b, to_window.start), frame(b, to_window.end));
+        let mut best: Option<(f32, ClipCut)> = None;
+        for f in fa0..=fa1 {
+            for t in transitions.get(f as usize).into_iter().flatten() {
+                if !(fb0..=fb1).contains(&t.to) {
+                    continue;
+                }
+                let base = match variant {
+                    Variant::Mg => t.posture,
+                    Variant::Lma => t.style,
+                };
+                let m = match (effort, self.effort_at(t.to)) {
+                    (Some(want), Some(have)) => want.matches(&have),
+                    _ => 0.0,
+                };
+                let score = base + EFFORT_WEIGHT * m;
+                if best.as_ref().is_none_or(|(s, _)| score > *s) {
+                    best = Some((
+                        score,
+                        ClipCut {
+                            from_time: (t.from - a.start) as f32 / super::FPS,
+                            to_time: (t.to - b.start) as f32 / super::FPS,
+                            posture: t.posture,
+                            style: t.style,
+                            effort_match: m,
+                        },
+                    ));
+                }
+            }
+        }
+        best.map(|(_, c)| c)
+    }
+}
+
 /// Clip indices ordered by how well their mean effort matches `effort` (best first), with the
 /// match ∈ [0, 1]; clips without a full window are left out.
 pub fn rank_clips_by_effort(
@@ -233,6 +321,25 @@ mod tests {
         assert!(g
             .best_transition(&tr, 0..10, &[], None, Variant::Lma)
             .is_none());
+        let cut = g
+            .best_cut_between(
+                &tr,
+                (0, 1.0..2.0),
+                (2, 0.0..3.0),
+                Some(Effort {
+                    time: 1.0,
+                    weight: 1.0,
+                }),
+                Variant::Lma,
+            )
+            .unwrap();
+        assert_eq!((cut.from_time, cut.to_time), (1.5, 1.5));
+        assert!(cut.effort_match > 0.0);
+        assert!(g
+            .best_cut_between(&tr, (0, 1.0..2.0), (1, 0.0..1.0), None, Variant::Mg)
+            .is_none());
+        assert_eq!(g.clip_index("wild"), Some(2));
+        assert_eq!(g.clip_index("/x/y/wild.bvh"), Some(2));
         let r = g.effort_correlation(45, 135).unwrap();
         assert!((-1.0..=1.0).contains(&r));
     }

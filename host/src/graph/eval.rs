@@ -6,7 +6,8 @@
 //! emotions (afraid, angry, excited, happy, relaxed, bored), else 0 for equal labels and 1 for
 //! different ones. Table 3 is used as printed (row = from, column = to; it is not symmetric for
 //! angry/happy). For each variant, `runs` walks of `transitions` transitions each are planned
-//! with synthesis by highest similarity (§5.3), and the mean cost C = (1/k) Σ cost(s_i, s_j),
+//! with synthesis by highest similarity (§5.3) — both variants starting each run from the same
+//! frame of their common component — and the mean cost C = (1/k) Σ cost(s_i, s_j),
 //! its standard deviation over runs, and the share of transitions crossing labels are reported,
 //! with the transition counts of both graphs (before / after LMA pruning).
 
@@ -110,6 +111,19 @@ pub fn evaluate(
     transitions: usize,
     seed: u64,
 ) -> Result<EvalReport, GraphError> {
+    // Both graphs start each run from the same frame (§5.3), drawn from their common part.
+    let scc_mg = g.largest_scc(&g.transitions(Variant::Mg, None, None));
+    let scc_lma = g.largest_scc(&g.transitions(Variant::Lma, None, None));
+    let common: Vec<u32> = (0..scc_mg.len() as u32)
+        .filter(|&f| scc_mg[f as usize] && scc_lma.get(f as usize).copied().unwrap_or(false))
+        .collect();
+    let start_of = |r: usize| -> Option<u32> {
+        if common.is_empty() {
+            return None;
+        }
+        let mut rng = Rng::new(seed.wrapping_mul(31).wrapping_add(r as u64));
+        Some(common[rng.range(0, common.len() - 1)])
+    };
     let one = |v: Variant| -> Result<VariantReport, GraphError> {
         let trans = g.transitions(v, None, None);
         let component_frames = g.largest_scc(&trans).iter().filter(|&&b| b).count();
@@ -119,7 +133,7 @@ pub fn evaluate(
         for r in 0..runs.max(1) {
             let mut rng = Rng::new(seed.wrapping_add(r as u64));
             let frames = transitions * MAX_SEGMENT + 1;
-            let p = plan(g, v, &Chooser::Similarity(v), frames, None, &mut rng)?;
+            let p = plan(g, v, &Chooser::Similarity(v), frames, start_of(r), &mut rng)?;
             let mut sum = 0.0f32;
             for (_, t) in p.cuts.iter().take(transitions) {
                 let (Some(a), Some(b)) = (g.clip_of(t.from), g.clip_of(t.to)) else {

@@ -7,7 +7,8 @@
 //! choice), or, by example, the destination window whose style best matches the reference clip's
 //! window at that output time. When the clip would leave the component, the best available
 //! transition is taken at once. Landing again near one of the last [`RECENT_JUMPS`] landings
-//! costs [`REPEAT_PENALTY`], so a walk does not loop one passage when it has other choices.
+//! costs [`REPEAT_PENALTY`], so a walk does not loop one passage when it has other choices, and
+//! landing where fewer than [`MIN_RUN`] frames can play costs [`SHORT_PENALTY`].
 //!
 //! Rendering turns the plan into poses of the source clips: every segment is placed with a
 //! rotation about the vertical and a floor translation (eq. 1's alignment of the two windows,
@@ -38,6 +39,11 @@ pub const MAX_SEGMENT: usize = 100;
 pub const RECENT_JUMPS: usize = 8;
 /// Score subtracted from a transition landing within a window of a recent jump's landing.
 pub const REPEAT_PENALTY: f32 = 1.0;
+
+/// Fewest frames a jump's destination should be able to play before the next forced jump.
+pub const MIN_RUN: usize = WINDOW;
+/// Score subtracted from a transition whose destination plays fewer than [`MIN_RUN`] frames.
+pub const SHORT_PENALTY: f32 = 0.5;
 
 /// A small seeded generator (SplitMix64) so plans are reproducible.
 #[derive(Debug, Clone)]
@@ -131,6 +137,17 @@ pub fn plan(
             _ => 0.0,
         }
     };
+    let next_natural = |f: u32| -> Option<u32> {
+        let c = &g.clips[g.clip_of(f)?];
+        (f + 1 < c.start + c.frames && scc[f as usize + 1]).then_some(f + 1)
+    };
+    // Frames playable from each frame before its clip leaves the component (backward pass).
+    let mut run = vec![0u32; scc.len()];
+    for f in (0..scc.len()).rev() {
+        if let Some(n) = next_natural(f as u32) {
+            run[f] = run[n as usize].saturating_add(1);
+        }
+    }
     // Destinations of the last few jumps: landing there again would loop the same passage.
     let recent = std::cell::RefCell::new(std::collections::VecDeque::<u32>::new());
     let score = |t: &Transition, out_frame: usize| -> f32 {
@@ -143,7 +160,10 @@ pub fn plan(
             .borrow()
             .iter()
             .any(|&r| r.abs_diff(t.to) < WINDOW as u32);
-        base - if repeat { REPEAT_PENALTY } else { 0.0 }
+        let short = run
+            .get(t.to as usize + 1)
+            .is_some_and(|&r| (r as usize) < MIN_RUN);
+        base - if repeat { REPEAT_PENALTY } else { 0.0 } - if short { SHORT_PENALTY } else { 0.0 }
     };
     let usable = |f: u32| -> Vec<Transition> {
         trans
@@ -155,10 +175,6 @@ pub fn plan(
                     .collect()
             })
             .unwrap_or_default()
-    };
-    let next_natural = |f: u32| -> Option<u32> {
-        let c = &g.clips[g.clip_of(f)?];
-        (f + 1 < c.start + c.frames && scc[f as usize + 1]).then_some(f + 1)
     };
     let mut cur = match start {
         Some(s) if scc.get(s as usize).copied().unwrap_or(false) => s,

@@ -59,8 +59,10 @@ pub struct Globals {
 pub struct FrameDraw {
     /// Per-frame constants.
     pub globals: Globals,
-    /// Limb and doodle capsules.
+    /// Limb capsules (drawn finely tessellated).
     pub capsules: Vec<Capsule>,
+    /// Doodle path segments (thin capsules, drawn coarsely tessellated).
+    pub doodle: Vec<Capsule>,
     /// Ground shadows.
     pub shadows: Vec<Shadow>,
     /// Overlay rectangles (pixels).
@@ -197,7 +199,8 @@ impl Composer {
                 params: [0.08 * m.size, 0.22 * m.size, 0.3 * fade, 0.0],
             });
         }
-        self.push_doodle(t, &mut capsules, &mut shadows);
+        let mut doodle = Vec::with_capacity(self.doodle.len());
+        self.push_doodle(t, &mut doodle, &mut capsules, &mut shadows);
         let aspect = width.max(1) as f32 / height.max(1) as f32;
         let dist = (camera.eye - camera.target).length();
         let bg = srgba(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2], 1.0);
@@ -222,12 +225,19 @@ impl Composer {
         FrameDraw {
             globals,
             capsules,
+            doodle,
             shadows,
             rects: overlay_rects(scene, t, width, height, status),
         }
     }
 
-    fn push_doodle(&self, t: f32, capsules: &mut Vec<Capsule>, shadows: &mut Vec<Shadow>) {
+    fn push_doodle(
+        &self,
+        t: f32,
+        segments: &mut Vec<Capsule>,
+        capsules: &mut Vec<Capsule>,
+        shadows: &mut Vec<Shadow>,
+    ) {
         let m = self.metrics;
         let r = m.size * 0.008;
         let past = srgba(0.85, 0.15, 0.55, 1.0);
@@ -237,7 +247,7 @@ impl Composer {
             if q.t < t - DOODLE_WINDOW_S || p.t > t + DOODLE_WINDOW_S {
                 continue;
             }
-            capsules.push(Capsule {
+            segments.push(Capsule {
                 a: p.pos.extend(r).to_array(),
                 b: q.pos.extend(0.0).to_array(),
                 colour: if q.t <= t { past } else { future },

@@ -14,12 +14,35 @@ use super::RenderError;
 
 /// Depth buffer format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// MSAA sample count of every render (4× smooths the limb silhouettes and grid).
+/// Default MSAA sample count (4× smooths the limb silhouettes and grid); 1 disables MSAA.
 pub const SAMPLE_COUNT: u32 = 4;
-/// Capsule tessellation: segments around the bone.
-const CAPSULE_SEGMENTS: u32 = 16;
-/// Capsule tessellation: rings per hemispherical cap.
-const CAPSULE_RINGS: u32 = 5;
+/// Environment variable overriding the MSAA sample count (`1` or `4`).
+pub const MSAA_ENV: &str = "FIGURINE_MSAA";
+
+/// Largest frame (pixels) that gets MSAA on a CPU adapter: lavapipe's 4× MSAA costs about
+/// 4× the frame time, which big frames cannot afford (and need less: their pixels are small).
+pub const CPU_MSAA_MAX_PIXELS: u32 = 640 * 360;
+
+/// The MSAA sample count for a `width` × `height` target on `adapter`: [`MSAA_ENV`] if it is
+/// `1` or `4`; else [`SAMPLE_COUNT`], except 1 on a CPU adapter (lavapipe) for frames larger
+/// than [`CPU_MSAA_MAX_PIXELS`].
+pub fn msaa_samples(adapter: &wgpu::Adapter, width: u32, height: u32) -> u32 {
+    match std::env::var(MSAA_ENV).ok().as_deref().map(str::trim) {
+        Some("1") => return 1,
+        Some("4") => return 4,
+        _ => {}
+    }
+    let cpu = adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    if cpu && width.saturating_mul(height) > CPU_MSAA_MAX_PIXELS {
+        1
+    } else {
+        SAMPLE_COUNT
+    }
+}
+/// Limb capsule tessellation: segments around the bone, rings per hemispherical cap.
+const LIMB_TESSELLATION: (u32, u32) = (16, 5);
+/// Doodle capsule tessellation (thin, many): segments around, rings per cap.
+const DOODLE_TESSELLATION: (u32, u32) = (6, 1);
 
 /// A wgpu device and queue, plus what adapter they run on.
 pub struct Gpu {
@@ -118,7 +141,9 @@ pub struct SceneRenderer {
     bind_group: wgpu::BindGroup,
     capsule_mesh: wgpu::Buffer,
     capsule_indices: wgpu::Buffer,
-    capsule_index_count: u32,
+    /// Index range and base vertex of the limb mesh, then of the doodle mesh.
+    meshes: [(std::ops::Range<u32>, i32); 2],
+    instances: Vec<Capsule>,
     capsules: InstanceBuffer,
     shadows: InstanceBuffer,
     rects: InstanceBuffer,
@@ -126,8 +151,7 @@ pub struct SceneRenderer {
 
 /// Vertices (local direction xyz, cap flag) and indices of the unit capsule: two hemispheres
 /// whose equators are joined by the cylinder; the vertex shader places and scales it.
-fn capsule_mesh() -> (Vec<[f32; 4]>, Vec<u16>) {
-    let (seg, rings) = (CAPSULE_SEGMENTS, CAPSULE_RINGS);
+fn capsule_mesh((seg, rings): (u32, u32)) -> (Vec<[f32; 4]>, Vec<u16>) {
     let mut verts = Vec::new();
     let total_rings = 2 * rings + 2;
     for k in 0..total_rings {
@@ -161,9 +185,9 @@ fn capsule_mesh() -> (Vec<[f32; 4]>, Vec<u16>) {
 }
 
 impl SceneRenderer {
-    /// Builds the pipelines for colour targets of `format` with [`SAMPLE_COUNT`] samples and a
-    /// [`DEPTH_FORMAT`] depth buffer.
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+    /// Builds the pipelines for colour targets of `format` with `samples` MSAA samples (1 or
+    /// 4) and a [`DEPTH_FORMAT`] depth buffer.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, samples: u32) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("figurine shader"),
             source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
@@ -230,7 +254,7 @@ impl SceneRenderer {
                     bias: Default::default(),
                 }),
                 multisample: wgpu::MultisampleState {
-                    count: SAMPLE_COUNT,
+                    count: samples,
                     ..Default::default()
                 },
                 fragment: Some(wgpu::FragmentState {
@@ -314,7 +338,15 @@ impl SceneRenderer {
             (false, Always),
             Some(wgpu::BlendState::ALPHA_BLENDING),
         );
-        let (verts, idx) = capsule_mesh();
+        let (mut verts, mut idx) = capsule_mesh(LIMB_TESSELLATION);
+        let limb = (0..idx.len() as u32, 0);
+        let (dv, di) = capsule_mesh(DOODLE_TESSELLATION);
+        let doodle = (
+            idx.len() as u32..(idx.len() + di.len()) as u32,
+            verts.len() as i32,
+        );
+        verts.extend(dv);
+        idx.extend(di);
         let capsule_mesh = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("capsule mesh"),
             contents: bytemuck::cast_slice(&verts),
@@ -334,7 +366,8 @@ impl SceneRenderer {
             bind_group,
             capsule_mesh,
             capsule_indices,
-            capsule_index_count: idx.len() as u32,
+            meshes: [limb, doodle],
+            instances: Vec::new(),
             capsules: InstanceBuffer::new(device, "capsule instances", 64 * 48),
             shadows: InstanceBuffer::new(device, "shadow instances", 64 * 32),
             rects: InstanceBuffer::new(device, "overlay rects", 512 * 32),
@@ -352,10 +385,18 @@ impl SceneRenderer {
         frame: &FrameDraw,
     ) {
         let (device, queue) = (&gpu.device, &gpu.queue);
-        let (msaa, depth) = (&attachments.msaa, &attachments.depth);
+        // Without MSAA, draw straight into the target.
+        let (view, resolve_target) = match &attachments.msaa {
+            Some(msaa) => (msaa, Some(resolve)),
+            None => (resolve, None),
+        };
+        let depth = &attachments.depth;
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&frame.globals));
+        self.instances.clear();
+        self.instances.extend_from_slice(&frame.capsules);
+        self.instances.extend_from_slice(&frame.doodle);
         self.capsules
-            .upload(device, queue, bytemuck::cast_slice(&frame.capsules));
+            .upload(device, queue, bytemuck::cast_slice(&self.instances));
         self.shadows
             .upload(device, queue, bytemuck::cast_slice(&frame.shadows));
         self.rects
@@ -364,9 +405,9 @@ impl SceneRenderer {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: msaa,
+                view,
                 depth_slice: None,
-                resolve_target: Some(resolve),
+                resolve_target,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color {
                         r: f64::from(r),
@@ -374,7 +415,11 @@ impl SceneRenderer {
                         b: f64::from(b),
                         a: 1.0,
                     }),
-                    store: wgpu::StoreOp::Discard,
+                    store: if resolve_target.is_some() {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -397,16 +442,20 @@ impl SceneRenderer {
             pass.set_vertex_buffer(0, self.shadows.buffer.slice(..));
             pass.draw(0..6, 0..frame.shadows.len() as u32);
         }
-        if !frame.capsules.is_empty() {
+        if !self.instances.is_empty() {
             pass.set_pipeline(&self.capsule_pipeline);
             pass.set_vertex_buffer(0, self.capsule_mesh.slice(..));
             pass.set_vertex_buffer(1, self.capsules.buffer.slice(..));
             pass.set_index_buffer(self.capsule_indices.slice(..), wgpu::IndexFormat::Uint16);
-            pass.draw_indexed(
-                0..self.capsule_index_count,
-                0,
-                0..frame.capsules.len() as u32,
-            );
+            let limbs = frame.capsules.len() as u32;
+            let all = self.instances.len() as u32;
+            let [(limb_idx, limb_base), (doodle_idx, doodle_base)] = self.meshes.clone();
+            if limbs > 0 {
+                pass.draw_indexed(limb_idx, limb_base, 0..limbs);
+            }
+            if all > limbs {
+                pass.draw_indexed(doodle_idx, doodle_base, limbs..all);
+            }
         }
         if !frame.rects.is_empty() {
             pass.set_pipeline(&self.rect_pipeline);
@@ -416,23 +465,25 @@ impl SceneRenderer {
     }
 }
 
-/// Multisampled colour and depth attachments of one size and format.
+/// Multisampled colour (when MSAA is on) and depth attachments of one size and format.
 pub struct Attachments {
-    /// Multisampled colour.
-    pub msaa: wgpu::TextureView,
-    /// Multisampled depth.
+    /// Multisampled colour; `None` without MSAA (drawing goes straight to the target).
+    pub msaa: Option<wgpu::TextureView>,
+    /// Depth, with the same sample count.
     pub depth: wgpu::TextureView,
     /// Size in pixels.
     pub size: (u32, u32),
 }
 
 impl Attachments {
-    /// Creates attachments of `width` × `height` pixels for colour `format`.
+    /// Creates attachments of `width` × `height` pixels for colour `format` with `samples`
+    /// samples per pixel.
     pub fn new(
         device: &wgpu::Device,
         width: u32,
         height: u32,
         format: wgpu::TextureFormat,
+        samples: u32,
     ) -> Self {
         let make = |label: &str, format: wgpu::TextureFormat| {
             device
@@ -444,7 +495,7 @@ impl Attachments {
                         depth_or_array_layers: 1,
                     },
                     mip_level_count: 1,
-                    sample_count: SAMPLE_COUNT,
+                    sample_count: samples,
                     dimension: wgpu::TextureDimension::D2,
                     format,
                     usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -453,7 +504,7 @@ impl Attachments {
                 .create_view(&Default::default())
         };
         Attachments {
-            msaa: make("msaa colour", format),
+            msaa: (samples > 1).then(|| make("msaa colour", format)),
             depth: make("depth", DEPTH_FORMAT),
             size: (width, height),
         }
@@ -466,7 +517,7 @@ mod tests {
 
     #[test]
     fn capsule_mesh_is_closed_and_indexed_in_range() {
-        let (v, i) = capsule_mesh();
+        let (v, i) = capsule_mesh(LIMB_TESSELLATION);
         assert!(i.iter().all(|&k| (k as usize) < v.len()));
         assert_eq!(i.len() % 3, 0);
         // Every direction is unit length; both caps are present.

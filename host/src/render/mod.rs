@@ -15,6 +15,17 @@
 //! - [`playback`], [`live`], [`viewer`]: the window viewer's state machine, the live pose
 //!   feed for puppetry, and the winit window itself.
 //! - [`procedural`]: a procedural walking stick figure for tests, benchmarks and demos.
+//!
+//! Usage:
+//! ```text
+//! figurine render ANIM.bvh [--doodle LOG.csv] [--events E.jsonl|LABELS.json] \
+//!     --out OUT.gif|OUT.mp4|OUT.png|DIR/ [--size WxH] [--fps N] [--at T] [--from S --to S]
+//! figurine view ANIM.bvh [--doodle LOG.csv] [--events E.jsonl] [--size WxH]
+//! ```
+//! `ANIM` may be `procedural` (the built-in walking figure). MSAA is 4× except on a CPU
+//! adapter for frames above 640×360 (`FIGURINE_MSAA=1|4` overrides). The golden image of
+//! `tests/render_gpu.rs` is regenerated with
+//! `FIGURINE_BLESS=1 cargo test -p figurine-host --test render_gpu golden` (then look at it).
 
 pub mod camera;
 pub mod cli;

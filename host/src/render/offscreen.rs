@@ -4,7 +4,7 @@
 use image::RgbaImage;
 
 use super::compose::FrameDraw;
-use super::gpu::{Attachments, Gpu, SceneRenderer};
+use super::gpu::{msaa_samples, Attachments, Gpu, SceneRenderer};
 use super::RenderError;
 
 /// Colour format of offscreen frames (sRGB-encoded 8-bit RGBA, what PNG/GIF expect).
@@ -41,8 +41,9 @@ impl OffscreenRenderer {
                 max: limit,
             });
         }
-        let renderer = SceneRenderer::new(&gpu.device, OFFSCREEN_FORMAT);
-        let attachments = Attachments::new(&gpu.device, width, height, OFFSCREEN_FORMAT);
+        let samples = msaa_samples(&gpu.adapter, width, height);
+        let renderer = SceneRenderer::new(&gpu.device, OFFSCREEN_FORMAT, samples);
+        let attachments = Attachments::new(&gpu.device, width, height, OFFSCREEN_FORMAT, samples);
         let resolve = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("resolved frame"),
             size: wgpu::Extent3d {

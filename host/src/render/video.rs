@@ -36,6 +36,8 @@ pub enum OutputKind {
     /// A folder of numbered PNG frames (an existing folder, a path ending in `/`, or a path
     /// without extension).
     PngFolder,
+    /// A file extension none of the above understands.
+    Unsupported,
 }
 
 impl OutputKind {
@@ -51,7 +53,8 @@ impl OutputKind {
             Some("gif") => OutputKind::Gif,
             Some("mp4" | "mov" | "mkv") => OutputKind::Video,
             Some("png") => OutputKind::Still,
-            _ => OutputKind::PngFolder,
+            None => OutputKind::PngFolder,
+            Some(_) => OutputKind::Unsupported,
         }
     }
 }
@@ -152,9 +155,20 @@ pub fn render_to_path(
 ) -> Result<RenderSummary, RenderError> {
     scene.validate()?;
     let started = Instant::now();
+    let kind = OutputKind::of(out);
+    if kind == OutputKind::Unsupported {
+        return Err(RenderError::Encode {
+            path: out.to_path_buf(),
+            reason: "unsupported output: use .gif, .mp4 (.mov, .mkv), .png (one still) or a \
+                     folder path ending in / (PNG frames)"
+                .into(),
+        });
+    }
+    if kind == OutputKind::Video && !ffmpeg_available() {
+        return Err(RenderError::NoFfmpeg);
+    }
     let mut renderer = OffscreenRenderer::new(opts.width, opts.height)?;
     let adapter = renderer.gpu().describe();
-    let kind = OutputKind::of(out);
     if kind == OutputKind::Still {
         let t = still_at.unwrap_or(scene.duration() * 0.5);
         let r0 = Instant::now();
@@ -191,7 +205,9 @@ pub fn render_to_path(
             )?)
         }
         OutputKind::Video => Box::new(FfmpegSink::spawn(out, opts.width, opts.height, fps)?),
-        OutputKind::PngFolder | OutputKind::Still => Box::new(PngFolderSink::create(out)?),
+        OutputKind::PngFolder | OutputKind::Still | OutputKind::Unsupported => {
+            Box::new(PngFolderSink::create(out)?)
+        }
     };
     let encoder = EncoderThread::start(sink);
     let mut frames = 0;
@@ -345,17 +361,14 @@ impl Palette {
         Palette { colours, lut }
     }
 
-    /// Palette indices of an RGBA image, with 4×4 ordered dithering to hide banding.
+    /// Palette indices of an RGBA image (nearest palette colour of each pixel's 5-bit RGB).
+    /// No dithering: the scene's flat colours and soft gradients quantise cleanly, and
+    /// undithered frames compress better.
     pub fn map(&self, img: &RgbaImage) -> Vec<u8> {
-        const BAYER: [i32; 16] = [0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5];
-        let w = img.width() as usize;
         img.as_raw()
             .chunks_exact(4)
-            .enumerate()
-            .map(|(k, px)| {
-                let (x, y) = (k % w, k / w);
-                let d = BAYER[(y & 3) * 4 + (x & 3)] - 8; // -8..7, a 5-bit step is 8
-                let q = |v: u8| ((i32::from(v) + d).clamp(0, 255) >> 3) as usize;
+            .map(|px| {
+                let q = |v: u8| usize::from(v >> 3);
                 self.lut[(q(px[0]) << 10) | (q(px[1]) << 5) | q(px[2])]
             })
             .collect()
@@ -582,6 +595,8 @@ mod tests {
         assert_eq!(OutputKind::of(Path::new("a.png")), OutputKind::Still);
         assert_eq!(OutputKind::of(Path::new("frames/")), OutputKind::PngFolder);
         assert_eq!(OutputKind::of(Path::new("frames")), OutputKind::PngFolder);
+        assert_eq!(OutputKind::of(Path::new("a.webm")), OutputKind::Unsupported);
+        assert_eq!(OutputKind::of(Path::new("a.webm/")), OutputKind::PngFolder);
     }
 
     #[test]

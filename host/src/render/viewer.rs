@@ -21,7 +21,7 @@ use winit::window::{Window, WindowId};
 
 use super::camera::{CameraPlan, SceneMetrics};
 use super::compose::Composer;
-use super::gpu::{Attachments, Gpu, SceneRenderer};
+use super::gpu::{msaa_samples, Attachments, Gpu, SceneRenderer};
 use super::live::{LatencyStats, LiveFeed};
 use super::overlay::OverlayLayout;
 use super::playback::{DragButton, ViewerInput, ViewerKey, ViewerState};
@@ -154,6 +154,7 @@ struct WindowGfx {
     gpu: Gpu,
     renderer: SceneRenderer,
     attachments: Attachments,
+    samples: u32,
 }
 
 struct App {
@@ -241,8 +242,10 @@ impl App {
             config.format = f;
         }
         surface.configure(&gpu.device, &config);
-        let renderer = SceneRenderer::new(&gpu.device, config.format);
-        let attachments = Attachments::new(&gpu.device, w, h, config.format);
+        // The window can be resized: decide once for its largest likely size.
+        let samples = msaa_samples(&gpu.adapter, w, h);
+        let renderer = SceneRenderer::new(&gpu.device, config.format, samples);
+        let attachments = Attachments::new(&gpu.device, w, h, config.format, samples);
         eprintln!("figurine view: {}", gpu.describe());
         self.gfx = Some(WindowGfx {
             window,
@@ -251,6 +254,7 @@ impl App {
             gpu,
             renderer,
             attachments,
+            samples,
         });
         Ok(())
     }
@@ -263,7 +267,7 @@ impl App {
             g.config.width = w;
             g.config.height = h;
             g.surface.configure(&g.gpu.device, &g.config);
-            g.attachments = Attachments::new(&g.gpu.device, w, h, g.config.format);
+            g.attachments = Attachments::new(&g.gpu.device, w, h, g.config.format, g.samples);
         }
     }
 
