@@ -48,6 +48,23 @@ pub fn firmware_elf() -> Result<PathBuf> {
 /// Marker the QEMU board puts into its ELF.
 const BOARD_TAG: &[u8] = b"figurine-board:qemu-mps2-an386";
 
+/// Makes QEMU receive SIGKILL when the thread that started it dies, so even a test process
+/// killed by a signal (when `Drop` cannot run) leaves no emulator behind.
+#[allow(unsafe_code)]
+fn die_with_parent(cmd: &mut Command) {
+    use std::os::unix::process::CommandExt;
+    // SAFETY: the closure runs in the child between fork and exec and only calls prctl,
+    // which is async-signal-safe.
+    unsafe {
+        cmd.pre_exec(|| {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == -1 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+}
+
 /// How to start the emulator.
 #[derive(Debug, Clone, Default)]
 pub struct QemuOptions {
@@ -98,6 +115,7 @@ impl Qemu {
         if opts.icount {
             cmd.args(["-icount", "shift=0"]);
         }
+        die_with_parent(&mut cmd);
         let child = cmd
             .stdin(Stdio::null())
             .stdout(std::fs::File::create(&log)?)

@@ -178,7 +178,13 @@ fn figure_latency_and_sustained_rate() {
         .zip(&sim.events)
         .filter_map(|((_, arrived), s)| {
             let sent = r.sent_at.get(s.decided_seq as usize).copied().flatten()?;
-            Some(arrived.saturating_duration_since(sent).as_secs_f64() * 1e3)
+            let ms = arrived.saturating_duration_since(sent).as_secs_f64() * 1e3;
+            let last = r.sent_at.iter().rposition(|x| x.is_some_and(|t| t <= *arrived));
+            eprintln!(
+                "    event decided at sample {} (end {}), arrived {ms:.2} ms later; last sample sent before arrival: {last:?}",
+                s.decided_seq, s.end_seq
+            );
+            Some(ms)
         })
         .collect();
     lat.sort_by(f64::total_cmp);

@@ -16,6 +16,7 @@ mod engine;
 mod executor;
 mod link_rx;
 mod link_tx;
+mod panic;
 mod stats;
 
 #[cfg(feature = "qemu")]

@@ -1,6 +1,6 @@
 //! The link subcommands: `figurine devices`, `upload`, `replay` (and `live`, in [`super::live`]).
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
@@ -117,8 +117,9 @@ pub fn upload_to(dev: &mut Device, blobs: &Blobs, quiet: bool) -> Result<()> {
             continue;
         }
         let port = dev.port().to_string();
+        let show = !quiet && std::io::stderr().is_terminal();
         dev.upload(kind, blob, |done, total| {
-            if !quiet {
+            if show {
                 eprint!("\r{port}: {kind:?} {done}/{total} bytes");
             }
         })

@@ -453,3 +453,75 @@ impl Drop for Device {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::io::Read;
+    use std::net::TcpListener;
+
+    use figurine_protocol::{encode_frame, Capacities};
+
+    use super::*;
+
+    /// A fake figurine on a TCP port that answers every frame with a `Hello` of `version`.
+    fn fake_device(version: u16) -> (PortSpec, std::thread::JoinHandle<()>) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let spec = PortSpec::Tcp(listener.local_addr().unwrap().to_string());
+        let handle = std::thread::spawn(move || {
+            let (mut sock, _) = listener.accept().unwrap();
+            let hello = DeviceToHost::Hello(DeviceHello {
+                protocol_version: version,
+                build_id: 7,
+                capacities: Capacities {
+                    max_actions: 32,
+                    max_pattern_len: 32,
+                    max_edits: 3,
+                    effort_features: 16,
+                    max_library_bytes: 1000,
+                    max_effort_bytes: 100,
+                    pose_queue: 32,
+                },
+                library_crc: 0,
+                effort_crc: 0,
+            });
+            let mut frame = [0u8; MAX_FRAME_LEN];
+            let n = encode_frame(&hello, &mut frame).unwrap();
+            let mut buf = [0u8; 256];
+            while let Ok(k) = sock.read(&mut buf) {
+                if k == 0 || sock.write_all(&frame[..n]).is_err() {
+                    break;
+                }
+            }
+        });
+        (spec, handle)
+    }
+
+    #[test]
+    fn a_device_with_another_protocol_version_is_refused_naming_both() {
+        let (spec, handle) = fake_device(PROTOCOL_VERSION + 1);
+        let err = Device::connect(&spec).err().expect("must refuse");
+        let text = err.to_string();
+        assert!(matches!(err, LinkError::Version { theirs, .. } if theirs == PROTOCOL_VERSION + 1));
+        assert!(
+            text.contains(&format!("version {}", PROTOCOL_VERSION + 1)),
+            "{text}"
+        );
+        assert!(
+            text.contains(&format!("version {PROTOCOL_VERSION}")),
+            "{text}"
+        );
+        assert!(text.contains("update the host"), "{text}");
+        handle.join().unwrap();
+    }
+
+    #[test]
+    fn an_unreachable_port_is_an_open_error() {
+        let l = TcpListener::bind("127.0.0.1:0").unwrap();
+        let spec = PortSpec::Tcp(l.local_addr().unwrap().to_string());
+        drop(l);
+        assert!(matches!(
+            Device::connect(&spec),
+            Err(LinkError::Open { .. })
+        ));
+    }
+}

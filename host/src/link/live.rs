@@ -147,9 +147,12 @@ impl Session<'_> {
                 weight: f64::from(e.weight) / 127.0,
                 distance: u32::from(e.distance),
             };
-            let mut line = serde_json::to_value(&rec).unwrap_or_default();
-            if self.many {
-                line["figurine"] = serde_json::Value::String(self.label.clone());
+            // Same JSON line as `simulate --jsonl`, plus the port with several figurines.
+            let mut line = serde_json::to_string(&rec).unwrap_or_default();
+            if self.many && line.ends_with('}') {
+                line.pop();
+                let label = serde_json::to_string(&self.label).unwrap_or_default();
+                line.push_str(&format!(",\"figurine\":{label}}}"));
             }
             if let Ok(mut out) = self.print.lock() {
                 let _ = writeln!(out, "{line}");

@@ -4,15 +4,15 @@
 //!   (`BufferedUarte`, [`RX_BUFFER`]/[`TX_BUFFER`] bytes); see `hw/README.md` for wiring;
 //! * clock: RTC1 as the embassy time driver; DWT cycle counter as the stopwatch (64 MHz);
 //! * flash: the NVMC over the STORE region of the root `memory.x` (64 KiB at 0xF_0000);
-//! * logs: defmt over RTT (probe-rs), panics print through defmt and halt.
+//! * logs: defmt over RTT (probe-rs); a panic logs its location and halts on `UDF`.
 
 use cortex_m::peripheral::DWT;
+use defmt_rtt as _;
 use embassy_nrf::buffered_uarte::{self, BufferedUarte, BufferedUarteRx, BufferedUarteTx};
 use embassy_nrf::nvmc::Nvmc;
 use embassy_nrf::{bind_interrupts, peripherals, uarte};
 use embedded_storage::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
 use static_cell::StaticCell;
-use {defmt_rtt as _, panic_probe as _};
 
 use super::Board;
 
@@ -163,4 +163,10 @@ pub fn init() -> Board {
         tx: SerialTx(tx),
         flash: Flash(Nvmc::new(p.NVMC)),
     }
+}
+
+/// Stops the board for good (a debugger shows the `UDF`); `code` is for the log only.
+pub fn halt(code: i32) -> ! {
+    defmt::error!("halted ({})", code);
+    cortex_m::asm::udf()
 }
