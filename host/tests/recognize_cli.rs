@@ -128,8 +128,14 @@ fn learn_then_simulate_a_sequence() {
         assert!((-1.0..=1.0).contains(&e.time) && (-1.0..=1.0).contains(&e.weight));
         // Efforts are the device's i8 values / 127 (serde_json's default float parser may be
         // one ulp off, so compare the numerators).
-        assert!(((e.time * 127.0).round() - e.time * 127.0).abs() < 1e-9, "{e:?}");
-        assert!(((e.weight * 127.0).round() - e.weight * 127.0).abs() < 1e-9, "{e:?}");
+        assert!(
+            ((e.time * 127.0).round() - e.time * 127.0).abs() < 1e-9,
+            "{e:?}"
+        );
+        assert!(
+            ((e.weight * 127.0).round() - e.weight * 127.0).abs() < 1e-9,
+            "{e:?}"
+        );
     }
     // The table form works with the shipped library and effort model.
     let out = figurine(&["simulate", log.to_str().unwrap()]);

@@ -28,6 +28,10 @@ pub fn bench() -> Result<()> {
     ]))?;
 
     step("firmware: sizes, instructions per sample, latency, sustained rate");
+    if !crate::util::have("defmt-print") {
+        // The mean instructions per sample come from the firmware's defmt log.
+        run(std::process::Command::new("cargo").args(["install", "--locked", "defmt-print"]))?;
+    }
     crate::tasks::firmware(crate::tasks::Board::Qemu, true)?;
     crate::tasks::firmware(crate::tasks::Board::Nrf52840, true)?;
     run(cargo().args([

@@ -178,10 +178,12 @@ fn run_tests(cmd: &mut Command) -> Result<(u64, u64)> {
     Ok((passed, failed))
 }
 
-/// Fuzz targets: (fuzz crate folder, target name, real-data files that seed its corpus as
-/// `(data subfolder, file-name suffix)`; the LAFAN-derived files may not be committed, so
-/// seeds from real data are copied in at run time).
-const FUZZ_TARGETS: &[(&str, &str, &[(&str, &str)])] = &[
+/// Real-data files that seed a fuzz corpus: `(data subfolder, file-name suffix)`. The
+/// LAFAN-derived files may not be committed, so these seeds are copied in at run time.
+type RealSeeds = &'static [(&'static str, &'static str)];
+
+/// Fuzz targets: (fuzz crate folder, target name, real-data seeds).
+const FUZZ_TARGETS: &[(&str, &str, RealSeeds)] = &[
     ("protocol/fuzz", "decode_stream", &[]),
     ("host/fuzz", "poselog_csv", &[]),
     ("host/fuzz", "bvh_import", &[("bvh", ".bvh")]),
@@ -191,6 +193,8 @@ const FUZZ_TARGETS: &[(&str, &str, &[(&str, &str)])] = &[
         &[("deepmimic", ".txt"), ("deepmimic", ".urdf")],
     ),
     ("host/fuzz", "events_jsonl", &[]),
+    ("firmware/recognizer/fuzz", "sample_feed", &[]),
+    ("firmware/recognizer/fuzz", "blobs", &[]),
 ];
 
 /// Runs every fuzz target for `seconds`; prints each target's execution count.
