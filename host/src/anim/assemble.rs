@@ -27,6 +27,7 @@ use glam::{Quat, Vec2, Vec3};
 
 use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
 use super::effort::{apply_effort, Effort, EffortClip};
+use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
@@ -52,6 +53,9 @@ pub struct AssembleOptions {
     pub transition_search_s: f32,
     /// Minimum blend duration, seconds.
     pub min_blend_s: f32,
+    /// With a motion graph: how far (seconds) from an action boundary its transitions are
+    /// looked for (graph transitions sit at 35-frame window centres, so they need more room).
+    pub graph_search_s: f32,
 }
 
 impl Default for AssembleOptions {
@@ -62,6 +66,7 @@ impl Default for AssembleOptions {
             hold_s: 0.5,
             transition_search_s: 0.25,
             min_blend_s: 0.2,
+            graph_search_s: 1.0,
         }
     }
 }
@@ -99,6 +104,9 @@ pub struct Assembly {
     pub ground: GroundFix,
     /// Transitions: (frame where the blend starts, frame where it ends).
     pub transitions: Vec<(usize, usize)>,
+    /// Per transition: the motion-graph cut it follows (`--graph`), or `None` where the
+    /// windowed posture distance chose it.
+    pub graph_cuts: Vec<Option<crate::graph::effort::ClipCut>>,
     /// Log-clock time (seconds) of output frame 0: the doodle's first sample, else 0 (or the
     /// first event's start if it is negative). Frame f shows log time `t_origin + f / fps`.
     pub t_origin: f64,
@@ -108,6 +116,12 @@ pub struct Assembly {
 struct Placed {
     f0: usize,
     poses: Vec<Pose>,
+    /// Per frame: the action clip's time shown, seconds.
+    src_times: Vec<f32>,
+    /// The event's recognised effort.
+    effort: Effort,
+    /// The action (key of the clip map).
+    action: String,
     /// Per frame, per leg: the source clip's foot contact at the frame's source time.
     contacts: Vec<Vec<bool>>,
 }
@@ -146,6 +160,19 @@ pub fn assemble(
     clips: &BTreeMap<String, ActionClip>,
     forward: Vec3,
     opts: &AssembleOptions,
+) -> Result<Assembly, AnimError> {
+    assemble_guided(events, doodle, clips, forward, opts, None)
+}
+
+/// [`assemble`], taking transitions from a motion graph where it has them (see
+/// [`super::graph_cuts`]).
+pub fn assemble_guided(
+    events: &[ActionRecord],
+    doodle: Option<&PoseLog>,
+    clips: &BTreeMap<String, ActionClip>,
+    forward: Vec3,
+    opts: &AssembleOptions,
+    guide: Option<&GraphGuide>,
 ) -> Result<Assembly, AnimError> {
     if events.is_empty() {
         return Err(AnimError::Data(
@@ -284,6 +311,9 @@ pub fn assemble(
             f0,
             poses,
             contacts,
+            src_times,
+            effort,
+            action: ev.action.clone(),
         });
         last_f1 = f1;
     }
@@ -292,9 +322,46 @@ pub fn assemble(
     let total = last_f1 + (opts.hold_s.max(0.0) * fps).round() as usize;
     let search = ((opts.transition_search_s * fps).round() as usize).max(1);
     let min_blend = ((opts.min_blend_s * fps).round() as usize).max(2);
+    let graph_search = ((opts.graph_search_s.max(0.0) * fps).round() as usize).max(search);
     let mut cuts: Vec<(usize, usize)> = Vec::new(); // (i, j) per boundary
+    let mut graph_cuts = Vec::new();
     for w in placed.windows(2) {
         let (a, b) = (&w[0], &w[1]);
+        let graph_cut = guide.and_then(|g| {
+            let src = |p: &'_ Placed| {
+                let ac = clips.get(&p.action)?;
+                Some((ac.file.clone(), ac.source_start_s))
+            };
+            let ((fa, sa), (fb, sb)) = (src(a)?, src(b)?);
+            let pa = PlacedSource {
+                file: &fa,
+                source_start_s: sa,
+                f0: a.f0,
+                src_times: &a.src_times,
+            };
+            let pb = PlacedSource {
+                file: &fb,
+                source_start_s: sb,
+                f0: b.f0,
+                src_times: &b.src_times,
+            };
+            let want = crate::graph::effort::Effort {
+                time: b.effort.time,
+                weight: b.effort.weight,
+            };
+            g.cut(
+                &pa,
+                a.f1().saturating_sub(graph_search).max(a.f0)..=a.f1(),
+                &pb,
+                b.f0..=(b.f0 + graph_search).min(b.f1()),
+                Some(want),
+            )
+        });
+        graph_cuts.push(graph_cut.map(|(_, _, c)| c));
+        if let Some((i, j, _)) = graph_cut {
+            cuts.push(widen(i, j, min_blend, a.f0, b.f1()));
+            continue;
+        }
         let ra = a.f1().saturating_sub(search).max(a.f0)..=a.f1();
         let rb = b.f0..=(b.f0 + search).min(b.f1());
         let pa: Vec<Vec<Vec3>> = (0..=a.f1())
@@ -315,17 +382,11 @@ pub fn assemble(
                 }
             })
             .collect();
-        let (mut i, mut j) = match best_pair(&pa, ra.clone(), &pb, rb.clone()) {
+        let (i, j) = match best_pair(&pa, ra.clone(), &pb, rb.clone()) {
             Some((i, j, _)) => (i, j),
             None => (a.f1(), b.f0),
         };
-        if j < i + min_blend {
-            let need = i + min_blend - j;
-            let back = (need / 2).min(i - a.f0);
-            i -= back;
-            j = (j + need - back).min(b.f1());
-        }
-        cuts.push((i, j));
+        cuts.push(widen(i, j, min_blend, a.f0, b.f1()));
     }
     let mut frames = Vec::with_capacity(total + 1);
     let mut contact_frames: Vec<Vec<bool>> = Vec::with_capacity(total + 1);
@@ -382,8 +443,21 @@ pub fn assemble(
         contacts,
         ground,
         transitions: cuts,
+        graph_cuts,
         t_origin: t_shift,
     })
+}
+
+/// Stretches a cut (i, j) to at least `min_blend` frames, half before and half after, staying
+/// within the outgoing action's first frame `a0` and the incoming action's last frame `b1`.
+fn widen(mut i: usize, mut j: usize, min_blend: usize, a0: usize, b1: usize) -> (usize, usize) {
+    if j < i + min_blend {
+        let need = i + min_blend - j;
+        let back = (need / 2).min(i.saturating_sub(a0));
+        i -= back;
+        j = (j + need - back).min(b1);
+    }
+    (i, j)
 }
 
 /// The toy's facing (object +Z) at the first sample, projected to the ground; +X otherwise.

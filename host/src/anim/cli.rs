@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 
-use super::assemble::{assemble, AssembleOptions, Assembly};
+use super::assemble::{assemble_guided, AssembleOptions, Assembly};
+use super::graph_cuts::GraphGuide;
 use super::library::ClipLibrary;
 use super::phrasing::detect_stages;
 use super::plot::save_contact_sheet;
@@ -52,6 +53,11 @@ pub struct AnimateArgs {
     /// Also draw a contact sheet (root path over the doodle path, stick figures) to this PNG.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Motion graph (`figurine graph build … --out G.bin`) over the library's source clips:
+    /// transitions between actions follow its LMA-MG transitions, preferring destinations
+    /// whose Effort features match the incoming action's recognised effort.
+    #[arg(long)]
+    pub graph: Option<PathBuf>,
 }
 
 /// Effort value given to a labelled Laban class (sudden/strong +, sustained/light −).
@@ -154,7 +160,15 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
         fps: args.fps,
         ..AssembleOptions::default()
     };
-    let asm = assemble(&events, doodle.as_ref(), &clips, library.forward(), &opts)?;
+    let guide = args.graph.as_deref().map(GraphGuide::load).transpose()?;
+    let asm = assemble_guided(
+        &events,
+        doodle.as_ref(),
+        &clips,
+        library.forward(),
+        &opts,
+        guide.as_ref(),
+    )?;
     write_bvh_path(&asm.clip, &args.out)?;
     if let Some(glb) = &args.glb {
         write_glb_path(&asm.clip, 1.0, glb)?;
@@ -225,6 +239,15 @@ fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
     );
     if let Some(g) = glb {
         println!("{}: binary glTF", g.display());
+    }
+    for ((i, j), cut) in asm.transitions.iter().zip(&asm.graph_cuts) {
+        match cut {
+            Some(c) => println!(
+                "  transition frames {i}-{j}: motion graph (source {:.2} s → {:.2} s, style {:.2}, effort match {:.2})",
+                c.from_time, c.to_time, c.style, c.effort_match
+            ),
+            None => println!("  transition frames {i}-{j}: posture distance"),
+        }
     }
     for p in &asm.placements {
         let stages: Vec<String> = p

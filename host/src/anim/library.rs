@@ -112,6 +112,11 @@ pub struct ActionClip {
     pub cyclic: bool,
     /// In place and anchored: the clip's net ground drift is removed.
     pub anchor: bool,
+    /// The source clip file it was cut from (for motion-graph look-ups).
+    pub file: PathBuf,
+    /// Seconds of the source file where this clip starts (its `frames` range); `None` when
+    /// played ping-pong (its time then has no monotone map to the source's).
+    pub source_start_s: Option<f32>,
 }
 
 impl ClipLibrary {
@@ -268,6 +273,8 @@ impl ClipLibrary {
                 c
             };
             clip.name = action.to_string();
+            let source_start_s = (!spec.pingpong)
+                .then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
             select_frames(&mut clip, spec, &self.origin, action)?;
             let joint_names: Vec<String> = clip
                 .skeleton
@@ -293,6 +300,8 @@ impl ClipLibrary {
                     moving: spec.moving,
                     cyclic: spec.cyclic,
                     anchor: spec.anchor && !spec.moving,
+                    file: path,
+                    source_start_s,
                 },
             );
         }

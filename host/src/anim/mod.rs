@@ -20,6 +20,7 @@ pub mod assemble;
 pub mod cli;
 pub mod contact;
 pub mod effort;
+pub mod graph_cuts;
 pub mod library;
 pub mod phrasing;
 pub mod plot;
