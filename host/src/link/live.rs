@@ -8,11 +8,16 @@
 //!   on the device).
 //! * Several `--port`s: one figurine per character, each in its own thread with its own
 //!   source (`--log` given once per port, in the same order); events carry a `figurine` field.
+//! * `--view`: puppetry. A window shows one character per figurine acting each recognised
+//!   action as it arrives (see [`crate::render::puppet`]); closing it ends the session, and
+//!   the time from event arrival to its first presented frame is reported.
 
 use std::fs::File;
 use std::io::{BufRead, BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::Sender;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
@@ -24,6 +29,7 @@ use super::replay::event_indices;
 use super::{Device, PortSpec};
 use crate::events::ActionRecord;
 use crate::poselog::PoseSample;
+use crate::render::puppet::PuppetMessage;
 
 /// Pause between reconnection attempts.
 pub const RECONNECT_EVERY: Duration = Duration::from_millis(500);
@@ -49,6 +55,15 @@ pub struct LiveArgs {
     /// added before the extension for port N ≥ 2.
     #[arg(long)]
     pub record: Option<PathBuf>,
+    /// Show the characters acting the recognised actions live in a window (puppetry).
+    #[arg(long)]
+    pub view: bool,
+    /// Clip library for `--view` (action → clip); default: the built-in DeepMimic library.
+    #[arg(long)]
+    pub clips: Option<PathBuf>,
+    /// With `--view`: close the window by itself after this many seconds (timed demos).
+    #[arg(long)]
+    pub quit_after: Option<f64>,
 }
 
 /// Parses one pose CSV data line (`t,x,y,z,qw,qx,qy,qz[,…]`); `None` for a header, a
@@ -94,6 +109,8 @@ struct Session<'a> {
     record: Option<BufWriter<File>>,
     print: &'a Mutex<std::io::Stdout>,
     many: bool,
+    /// With `--view`: this figurine's character and the puppets' channel.
+    puppet: Option<(u16, Sender<PuppetMessage>)>,
 }
 
 impl Session<'_> {
@@ -158,6 +175,10 @@ impl Session<'_> {
                 let _ = writeln!(out, "{line}");
                 let _ = out.flush();
             }
+            if let Some((character, tx)) = &self.puppet {
+                // The viewer may already be gone; the session goes on regardless.
+                let _ = tx.send((*character, rec, Instant::now()));
+            }
         }
     }
 
@@ -203,6 +224,7 @@ struct Plan {
     source: Option<PathBuf>,
     speed: f64,
     record: Option<PathBuf>,
+    puppet: Option<(u16, Sender<PuppetMessage>)>,
 }
 
 fn run_session(
@@ -210,12 +232,14 @@ fn run_session(
     names: &[String],
     print: &Mutex<std::io::Stdout>,
     many: bool,
+    stop: &AtomicBool,
 ) -> Result<()> {
     let Plan {
         spec,
         source,
         speed,
         record,
+        puppet,
     } = plan;
     let label = spec.to_string();
     let record = match record {
@@ -240,6 +264,7 @@ fn run_session(
         record,
         print,
         many,
+        puppet,
     };
     s.ensure_connected();
     if let Some(dev) = s.dev.as_mut() {
@@ -252,6 +277,9 @@ fn run_session(
             let t0 = log.samples.first().map_or(0.0, |p| p.t);
             let start = Instant::now();
             for p in &log.samples {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
                 let due = start + Duration::from_secs_f64(((p.t - t0) / speed.max(1e-6)).max(0.0));
                 if let Some(w) = due.checked_duration_since(Instant::now()) {
                     std::thread::sleep(w);
@@ -262,6 +290,9 @@ fn run_session(
         None => {
             let stdin = std::io::stdin();
             for line in stdin.lock().lines() {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
                 if let Some(p) = parse_pose_line(&line?) {
                     s.pose(&p)?;
                 }
@@ -288,6 +319,12 @@ pub fn live(args: &LiveArgs) -> Result<()> {
     }
     let print = Mutex::new(std::io::stdout());
     let many = specs.len() > 1;
+    let stop = AtomicBool::new(false);
+    let view = if args.view {
+        Some(start_view(args, &names, specs.len())?)
+    } else {
+        None
+    };
     std::thread::scope(|scope| {
         let handles: Vec<_> = specs
             .into_iter()
@@ -298,11 +335,28 @@ pub fn live(args: &LiveArgs) -> Result<()> {
                     source: args.logs.get(n).cloned(),
                     speed: args.speed,
                     record: args.record.as_deref().map(|r| record_path(r, n)),
+                    puppet: view.as_ref().map(|v| (n as u16, v.tx.clone())),
                 };
-                let (names, print) = (&names, &print);
-                scope.spawn(move || run_session(plan, names, print, many))
+                let (names, print, stop) = (&names, &print, &stop);
+                scope.spawn(move || run_session(plan, names, print, many, stop))
             })
             .collect();
+        if let Some(v) = &view {
+            // The window must live on the main thread; closing it ends the session.
+            let opts = crate::render::viewer::ViewerOptions {
+                quit_after: args
+                    .quit_after
+                    .filter(|s| s.is_finite() && *s > 0.0)
+                    .map(Duration::from_secs_f64),
+                ..Default::default()
+            };
+            let shown = crate::render::viewer::run_live_viewer(v.feed.clone(), opts);
+            stop.store(true, Ordering::Relaxed);
+            v.feed.close();
+            if let Err(e) = shown {
+                eprintln!("live view: {e}");
+            }
+        }
         handles
             .into_iter()
             .map(|h| {
@@ -311,7 +365,55 @@ pub fn live(args: &LiveArgs) -> Result<()> {
             })
             .collect::<Result<Vec<()>>>()
     })?;
+    if let Some(v) = view {
+        v.feed.close();
+        drop(v.tx);
+        let _ = v.thread.join();
+    }
     Ok(())
+}
+
+/// The puppetry side of `live --view`: the feed the window shows and the puppets' channel.
+struct View {
+    feed: crate::render::live::LiveFeed,
+    tx: Sender<PuppetMessage>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+fn start_view(args: &LiveArgs, names: &[String], characters: usize) -> Result<View> {
+    use crate::anim::library::ClipLibrary;
+    let lib = match &args.clips {
+        Some(p) => ClipLibrary::read_path(p)?,
+        None => ClipLibrary::default_library()?,
+    };
+    let mapped: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| lib.actions.contains_key(*n))
+        .collect();
+    let unmapped: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| !lib.actions.contains_key(*n))
+        .collect();
+    if !unmapped.is_empty() {
+        eprintln!(
+            "live view: no clip for {}; those actions are printed but not acted",
+            unmapped.join(", ")
+        );
+    }
+    if mapped.is_empty() {
+        bail!(
+            "live view: the clip library {} maps none of the figurine's actions",
+            lib.origin
+        );
+    }
+    let clips = Arc::new(lib.load(mapped)?);
+    let feed = crate::render::live::LiveFeed::new();
+    let characters = u16::try_from(characters).unwrap_or(u16::MAX);
+    let (tx, thread) =
+        crate::render::puppet::spawn_puppets(feed.clone(), clips, lib.forward(), characters);
+    Ok(View { feed, tx, thread })
 }
 
 #[cfg(test)]

@@ -37,6 +37,7 @@ pub mod offscreen;
 pub mod overlay;
 pub mod playback;
 pub mod procedural;
+pub mod puppet;
 pub mod scene;
 pub mod video;
 pub mod viewer;
