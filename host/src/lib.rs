@@ -9,6 +9,7 @@ pub mod graph;
 pub mod link;
 pub mod motion;
 pub mod poselog;
+pub mod raster;
 pub mod recognize;
 pub mod render;
 pub mod synth;

@@ -13,7 +13,6 @@ pub mod effort_model;
 pub mod effort_train;
 pub mod eval;
 pub mod feed;
-pub mod font;
 pub mod learn;
 pub mod library;
 pub mod regex;

@@ -8,7 +8,7 @@ use figurine_recognizer::features::FEATURES;
 use image::{Rgb, RgbImage};
 
 use super::effort_train::{Example, Trained};
-use super::font::{draw_text, fill_rect, line};
+use crate::raster::{draw_text, fill_rect, line};
 
 const W: u32 = 960;
 const H: u32 = 720;

@@ -33,7 +33,6 @@
 
 pub mod cli;
 pub mod effort;
-pub mod font;
 pub mod gesture;
 pub mod knobs;
 pub mod noise;

@@ -21,9 +21,9 @@ use glam::{DQuat, DVec3};
 use image::{Rgb, RgbImage};
 
 use super::effort::{TimeClass, WeightClass};
-use super::font::{draw_text, text_width};
 use super::sequence::Label;
 use crate::poselog::PoseLog;
+use crate::raster::{draw_text, text_width};
 
 /// Picture width, pixels.
 pub const WIDTH: u32 = 1200;

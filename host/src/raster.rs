@@ -1,6 +1,15 @@
-//! A tiny 5×7 bitmap font for labelling PNG reports (upper case, digits, a few signs).
+//! Small raster drawing for the PNG reports and plots (effort-training report, synth plots):
+//! a 5×7 bitmap font (upper case, digits, a few signs), pixels, rectangles and lines, all
+//! clipped to the image, so the pictures explain themselves without a font file.
 
 use image::{Rgb, RgbImage};
+
+/// Glyph width, pixels (before scaling).
+pub const GLYPH_W: u32 = 5;
+/// Glyph height, pixels (before scaling).
+pub const GLYPH_H: u32 = 7;
+/// Horizontal advance per character, pixels (before scaling).
+pub const ADVANCE: u32 = GLYPH_W + 1;
 
 /// Glyph rows (5 bits, MSB left) for a character; unknown characters draw as a box.
 fn glyph(c: char) -> [u8; 7] {
@@ -59,25 +68,37 @@ fn glyph(c: char) -> [u8; 7] {
     }
 }
 
-/// Draws `text` with its top-left corner at (x, y), `scale` pixels per font pixel.
-pub fn draw_text(img: &mut RgbImage, x: i64, y: i64, text: &str, scale: i64, color: Rgb<u8>) {
+/// Width in pixels of `text` drawn at `scale`.
+pub fn text_width(text: &str, scale: u32) -> u32 {
+    text.chars().count() as u32 * ADVANCE * scale
+}
+
+/// Draws `text` with its top-left corner at (`x`, `y`) pixels, each font pixel a
+/// `scale`×`scale` block (at least 1); pixels outside the image are skipped.
+pub fn draw_text(
+    img: &mut RgbImage,
+    x: i64,
+    y: i64,
+    text: &str,
+    scale: impl Into<i64>,
+    colour: Rgb<u8>,
+) {
+    let scale = scale.into().max(1);
     for (k, c) in text.chars().enumerate() {
-        let g = glyph(c);
-        let ox = x + k as i64 * 6 * scale;
-        for (row, bits) in g.iter().enumerate() {
-            for col in 0..5 {
-                if bits & (1 << (4 - col)) != 0 {
-                    for dy in 0..scale {
-                        for dx in 0..scale {
-                            put(
-                                img,
-                                ox + col * scale + dx,
-                                y + row as i64 * scale + dy,
-                                color,
-                            );
-                        }
-                    }
+        let ox = x + k as i64 * i64::from(ADVANCE) * scale;
+        for (row, bits) in glyph(c).iter().enumerate() {
+            for col in 0..i64::from(GLYPH_W) {
+                if bits & (1 << (i64::from(GLYPH_W) - 1 - col)) == 0 {
+                    continue;
                 }
+                fill_rect(
+                    img,
+                    ox + col * scale,
+                    y + row as i64 * scale,
+                    scale,
+                    scale,
+                    colour,
+                );
             }
         }
     }
@@ -118,5 +139,32 @@ pub fn line(img: &mut RgbImage, (x0, y0): (i64, i64), (x1, y1): (i64, i64), c: R
             err += dx;
             y += sy;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draws_inside_and_clips_outside() {
+        let mut img = RgbImage::from_pixel(40, 20, Rgb([255, 255, 255]));
+        draw_text(&mut img, 1, 1, "A1", 1u32, Rgb([0, 0, 0]));
+        let ink = img.pixels().filter(|p| p.0 == [0, 0, 0]).count();
+        // 'A' has 18 pixels on, '1' has 10.
+        assert_eq!(ink, 28);
+        draw_text(&mut img, -100, -100, "WAVE", 3u32, Rgb([0, 0, 0]));
+        draw_text(&mut img, 35, 15, "WAVE", 3u32, Rgb([0, 0, 0]));
+        assert_eq!(text_width("ab", 2), 24);
+        assert_eq!(glyph('a'), glyph('A'));
+    }
+
+    #[test]
+    fn lines_and_rects_are_clipped() {
+        let mut img = RgbImage::from_pixel(10, 10, Rgb([0, 0, 0]));
+        line(&mut img, (-5, -5), (20, 20), Rgb([255, 0, 0]));
+        fill_rect(&mut img, 8, 8, 10, 10, Rgb([0, 255, 0]));
+        assert_eq!(img.get_pixel(0, 0).0, [255, 0, 0]);
+        assert_eq!(img.get_pixel(9, 9).0, [0, 255, 0]);
     }
 }
