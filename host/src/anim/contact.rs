@@ -275,18 +275,11 @@ pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, tar
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::skeleton::{Joint, RotationOrder};
+    use crate::motion::skeleton::Joint;
     use crate::motion::Pose;
 
     fn leg_clip() -> Clip {
-        let j = |name: &str, parent, offset| Joint {
-            name: name.into(),
-            parent,
-            offset,
-            channels: vec![],
-            rotation_order: RotationOrder::ZYX,
-            end_site: false,
-        };
+        let j = Joint::bare;
         let sk = Skeleton {
             joints: vec![
                 j("pelvis", None, Vec3::ZERO),

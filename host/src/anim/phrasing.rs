@@ -254,20 +254,13 @@ fn direction(pos: &[Vec<Vec3>], (a, b): (usize, usize)) -> Direction {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::skeleton::{Joint, RotationOrder, Skeleton};
+    use crate::motion::skeleton::{Joint, Skeleton};
     use crate::motion::Pose;
     use glam::Quat;
 
     /// A one-arm clip: swing back (anticipation), swing far forward (execution), settle.
     fn swing() -> Clip {
-        let j = |name: &str, parent, offset| Joint {
-            name: name.into(),
-            parent,
-            offset,
-            channels: vec![],
-            rotation_order: RotationOrder::ZYX,
-            end_site: false,
-        };
+        let j = Joint::bare;
         let sk = Skeleton {
             joints: vec![
                 j("root", None, Vec3::ZERO),

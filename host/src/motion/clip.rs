@@ -200,17 +200,10 @@ impl Clip {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::skeleton::{Joint, RotationOrder};
+    use crate::motion::skeleton::Joint;
 
     fn arm() -> Skeleton {
-        let j = |name: &str, parent, offset| Joint {
-            name: name.into(),
-            parent,
-            offset,
-            channels: vec![],
-            rotation_order: RotationOrder::ZYX,
-            end_site: false,
-        };
+        let j = Joint::bare;
         Skeleton {
             joints: vec![
                 j("root", None, Vec3::ZERO),

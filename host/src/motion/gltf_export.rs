@@ -323,18 +323,11 @@ impl Builder {
 mod tests {
     use super::*;
     use crate::motion::clip::Pose;
-    use crate::motion::skeleton::{Joint, RotationOrder, Skeleton};
+    use crate::motion::skeleton::{Joint, Skeleton};
 
     #[test]
     fn glb_has_valid_header_and_chunks() {
-        let j = |name: &str, parent, offset| Joint {
-            name: name.into(),
-            parent,
-            offset,
-            channels: vec![],
-            rotation_order: RotationOrder::ZYX,
-            end_site: false,
-        };
+        let j = Joint::bare;
         let sk = Skeleton {
             joints: vec![j("root", None, Vec3::ZERO), j("a", Some(0), Vec3::Y)],
         };

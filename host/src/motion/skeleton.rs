@@ -149,6 +149,18 @@ pub struct Joint {
 }
 
 impl Joint {
+    /// A joint built in code (no file channels, ZYX order): for programmatic rigs and tests.
+    pub fn bare(name: &str, parent: Option<usize>, offset: Vec3) -> Joint {
+        Joint {
+            name: name.into(),
+            parent,
+            offset,
+            channels: Vec::new(),
+            rotation_order: RotationOrder::ZYX,
+            end_site: false,
+        }
+    }
+
     /// Whether the joint has any position channel (its local translation is animated).
     pub fn has_position(&self) -> bool {
         self.channels
