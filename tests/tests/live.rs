@@ -94,6 +94,9 @@ fn live_session_survives_an_unplug_and_records_every_pose() {
         speed: 8.0,
         library: None,
         record: Some(rec_path.clone()),
+        view: false,
+        clips: None,
+        quit_after: None,
     })
     .expect("live session");
     stop.store(true, Ordering::Relaxed);

@@ -6,6 +6,7 @@
 //! * `demo` — the main job: a doodle recognised, animated, rendered (target/demo/).
 //! * `bench` — prints every figure (sizes, speed, accuracy, instructions, render, graph).
 //! * `e2e` — the firmware in QEMU against the host.
+//! * `soak --seconds N --rate HZ` — a long pose stream into the QEMU firmware.
 //! * `firmware --board qemu|nrf52840` — builds the firmware binary.
 //! * `fuzz --seconds N` — runs every cargo-fuzz target for N seconds (nightly).
 
@@ -37,6 +38,15 @@ enum Cmd {
     Bench,
     /// Build the QEMU firmware and run the end-to-end tests against it.
     E2e,
+    /// Stream poses into the QEMU firmware for a long time and report drops and high-water marks.
+    Soak {
+        /// Duration, seconds.
+        #[arg(long, default_value_t = 600)]
+        seconds: u64,
+        /// Pose rate, Hz.
+        #[arg(long, default_value_t = 1000)]
+        rate: u64,
+    },
     /// Fetch only the real motion data into target/figurine-data.
     Data,
     /// Run every check and test (calls setup first).
@@ -66,6 +76,7 @@ fn main() -> anyhow::Result<()> {
         Cmd::Demo => demo::demo().map(|_| ()),
         Cmd::Bench => bench::bench(),
         Cmd::E2e => tasks::e2e(),
+        Cmd::Soak { seconds, rate } => tasks::soak(seconds, rate),
         Cmd::Test => tasks::test(),
         Cmd::Firmware { board, debug } => tasks::firmware(board, !debug),
         Cmd::Fuzz { seconds } => tasks::fuzz(seconds),

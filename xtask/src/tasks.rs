@@ -70,6 +70,30 @@ pub fn e2e() -> Result<()> {
     Ok(())
 }
 
+/// A long pose stream into the QEMU firmware: 0 drops expected; prints queue high-water marks
+/// and the worst per-sample cycle count.
+pub fn soak(seconds: u64, rate_hz: u64) -> Result<()> {
+    crate::setup::setup()?;
+    firmware(Board::Qemu, true)?;
+    step(&format!(
+        "soak: {rate_hz} Hz for {seconds} s into the QEMU firmware"
+    ));
+    run(cargo()
+        .env("FIGURINE_SOAK_SECONDS", seconds.to_string())
+        .env("FIGURINE_SOAK_RATE_HZ", rate_hz.to_string())
+        .args([
+            "test",
+            "--release",
+            "-p",
+            "figurine-e2e",
+            "--test",
+            "soak",
+            "--",
+            "--ignored",
+            "--nocapture",
+        ]))
+}
+
 /// Everything CI checks.
 pub fn test() -> Result<()> {
     let start = Instant::now();
@@ -178,8 +202,9 @@ fn run_tests(cmd: &mut Command) -> Result<(u64, u64)> {
     Ok((passed, failed))
 }
 
-/// Real-data files that seed a fuzz corpus: `(data subfolder, file-name suffix)`. The
-/// LAFAN-derived files may not be committed, so these seeds are copied in at run time.
+/// Real files that seed a fuzz corpus: `(data subfolder, file-name suffix)`; a folder
+/// starting with `@` is in the repository instead of the data folder. The LAFAN-derived files
+/// may not be committed, so these seeds are copied in at run time.
 type RealSeeds = &'static [(&'static str, &'static str)];
 
 /// Fuzz targets: (fuzz crate folder, target name, real-data seeds).
@@ -193,6 +218,16 @@ const FUZZ_TARGETS: &[(&str, &str, RealSeeds)] = &[
         &[("deepmimic", ".txt"), ("deepmimic", ".urdf")],
     ),
     ("host/fuzz", "events_jsonl", &[]),
+    (
+        "host/fuzz",
+        "library_json",
+        &[("@host/assets", "library.json")],
+    ),
+    (
+        "host/fuzz",
+        "effort_json",
+        &[("@host/assets", "effort.json")],
+    ),
     ("firmware/recognizer/fuzz", "sample_feed", &[]),
     ("firmware/recognizer/fuzz", "blobs", &[]),
 ];
