@@ -25,9 +25,8 @@ use clap::Args;
 use figurine_protocol::{HostToDevice, Pose};
 
 use super::blobs;
-use super::replay::event_indices;
+use super::replay::record_with_times;
 use super::{Device, PortSpec};
-use crate::events::ActionRecord;
 use crate::poselog::PoseSample;
 use crate::render::puppet::PuppetMessage;
 
@@ -150,20 +149,10 @@ impl Session<'_> {
             Err(e) => return self.lost(&e),
         };
         for e in events {
-            let (start, end) = event_indices(&e, self.sent.saturating_sub(1));
-            let t = |i: usize| self.times.get(i % SEQ_RING).copied().unwrap_or(f64::NAN);
-            let rec = ActionRecord {
-                action: self
-                    .names
-                    .get(usize::from(e.action))
-                    .cloned()
-                    .unwrap_or_else(|| format!("#{}", e.action)),
-                start: t(start),
-                end: t(end),
-                time: f64::from(e.time) / 127.0,
-                weight: f64::from(e.weight) / 127.0,
-                distance: u32::from(e.distance),
-            };
+            let times = &self.times;
+            let rec = record_with_times(&e, self.names, self.sent.saturating_sub(1), |i| {
+                times.get(i % SEQ_RING).copied().unwrap_or(f64::NAN)
+            });
             // Same JSON line as `simulate --jsonl`, plus the port with several figurines.
             let mut line = serde_json::to_string(&rec).unwrap_or_default();
             if self.many && line.ends_with('}') {

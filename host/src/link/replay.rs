@@ -69,8 +69,19 @@ pub fn to_record(
     log: &PoseLog,
     last_sent: usize,
 ) -> ActionRecord {
+    record_with_times(e, names, last_sent, |i| {
+        log.samples.get(i).map_or(f64::NAN, |s| s.t)
+    })
+}
+
+/// The record of a device event, given the time (seconds) of the `i`-th pose sent.
+pub fn record_with_times(
+    e: &ActionEvent,
+    names: &[String],
+    last_sent: usize,
+    t: impl Fn(usize) -> f64,
+) -> ActionRecord {
     let (start, end) = event_indices(e, last_sent);
-    let t = |i: usize| log.samples.get(i).map_or(f64::NAN, |s| s.t);
     ActionRecord {
         action: names
             .get(usize::from(e.action))
