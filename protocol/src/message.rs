@@ -86,7 +86,8 @@ pub struct ActionEvent {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BlobKind {
-    /// The compiled action library (patterns and names).
+    /// The compiled action library (the patterns; action names stay on the host, which maps
+    /// action indices back to names).
     Library,
     /// The effort model (selected features and Gaussian parameters).
     Effort,
@@ -196,7 +197,9 @@ pub enum HostToDevice {
     UploadChunk(UploadChunk),
     /// Verify and persist the uploaded blob; answered by `UploadDone` or `Error`.
     UploadCommit(BlobKind),
-    /// Restart recognition and statistics (the library stays).
+    /// End of a session: the device first emits any action still waiting for its
+    /// look-ahead (as host simulation does at the end of a log), then restarts recognition
+    /// and statistics. The library and effort model stay.
     Reset,
     /// Ask for `Stats`.
     GetStats,
