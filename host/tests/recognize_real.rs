@@ -8,6 +8,7 @@
 use figurine_host::data::data_file;
 use figurine_host::poselog::{PoseLog, PoseSample};
 use figurine_host::recognize::feed::{log_runs, log_samples};
+use figurine_host::recognize::learn::edit_distance;
 use figurine_host::recognize::simulate::{load_effort, load_library, simulate_log};
 use figurine_recognizer::token::{Token, STILL};
 
@@ -74,17 +75,7 @@ fn tokens(log: &PoseLog) -> Vec<Token> {
 }
 
 fn drift(a: &[Token], b: &[Token]) -> f64 {
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, x) in a.iter().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, y) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(x != y))
-                .min(prev[j + 1] + 1)
-                .min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()] as f64 / a.len().max(b.len()).max(1) as f64
+    edit_distance(a, b) as f64 / a.len().max(b.len()).max(1) as f64
 }
 
 fn check(name: &str, log: PoseLog) {

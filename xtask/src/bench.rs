@@ -4,6 +4,19 @@ use anyhow::Result;
 
 use crate::util::{cargo, run, step};
 
+/// Runs one of the host crate's benchmark examples in release mode.
+fn host_example(name: &str) -> Result<()> {
+    run(cargo().args([
+        "run",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--example",
+        name,
+    ]))
+}
+
 /// Runs every benchmark in turn, each printing its own figures with its command.
 pub fn bench() -> Result<()> {
     crate::setup::setup()?;
@@ -50,26 +63,10 @@ pub fn bench() -> Result<()> {
     ]))?;
 
     step("render: 30 s at 30 fps, 1280x720 (cargo run --release -p figurine-host --example render_bench)");
-    run(cargo().args([
-        "run",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--example",
-        "render_bench",
-    ]))?;
+    host_example("render_bench")?;
 
     step("motion graph build at ~10k/27k/54k frames (cargo run --release -p figurine-host --example graph_bench)");
-    run(cargo().args([
-        "run",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--example",
-        "graph_bench",
-    ]))?;
+    host_example("graph_bench")?;
 
     Ok(())
 }

@@ -454,7 +454,6 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
     Ok(None)
 }
 
-/// Learns `name` from example logs; returns the entry and the per-example token strings.
 fn mirror_seq(s: &Tokenized) -> Tokenized {
     let flags = ANY_LIN | ANY_ROT;
     s.iter()
@@ -462,7 +461,8 @@ fn mirror_seq(s: &Tokenized) -> Tokenized {
         .collect()
 }
 
-fn edit_distance(a: &[Token], b: &[Token]) -> usize {
+/// Levenshtein distance between two token strings (insertions, deletions, substitutions).
+pub fn edit_distance(a: &[Token], b: &[Token]) -> usize {
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     for (i, x) in a.iter().enumerate() {
         let mut cur = vec![i + 1; b.len() + 1];
