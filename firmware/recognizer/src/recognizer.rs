@@ -14,8 +14,8 @@ use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    Candidate, Decider, Decision, CYCLIC_PAUSE_US, HOLD_BACK_TOKENS, HOLD_US, LONG_PAUSE_US,
-    LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
+    edits_fit, Candidate, Decider, Decision, CYCLIC_PAUSE_US, HOLD_BACK_TOKENS, HOLD_US,
+    LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -344,6 +344,9 @@ impl<'lib> Recognizer<'lib> {
             };
             let found = earliest_start(&p, d, |j| if j < n { tok.get(j).copied() } else { None });
             let Some((j, k)) = found else { continue };
+            if !edits_fit(k, j + 1) {
+                continue;
+            }
             let c = Candidate {
                 action: a as u8,
                 start: idx.get(j).copied().unwrap_or(end),

@@ -25,6 +25,17 @@ pub const CYCLIC_PAUSE_US: u64 = 260_000;
 /// Stillness inside a longer action that does not yet commit a shorter pending one, µs: a
 /// punch held at full reach, a crouch held low.
 pub const HOLD_US: u64 = 500_000;
+/// Edits a match may spend per token it covers, as (edits, tokens): 2 per 5. A pattern's own
+/// bound (up to [`crate::pattern::MAX_EDITS`]) caps the total; this share keeps a short match
+/// from being mostly edits, so the bound can be generous for long performances without
+/// turning a lone stroke into any action.
+pub const EDIT_SHARE: (usize, usize) = (2, 5);
+
+/// Whether a match of `len` tokens with `edits` edits is close enough ([`EDIT_SHARE`]).
+pub const fn edits_fit(edits: u8, len: usize) -> bool {
+    (edits as usize) * EDIT_SHARE.1 <= EDIT_SHARE.0 * len
+}
+
 /// Shortest action that is emitted, µs (first run's start to last run's end).
 pub const MIN_ACTION_US: u64 = 150_000;
 /// Moving runs before a pending candidate where a longer action in progress may have begun.
@@ -174,6 +185,16 @@ mod tests {
             assert_eq!(d.offer(None, 0), Decision::Wait);
         }
         assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
+    }
+
+    #[test]
+    fn edits_are_bounded_by_the_share_of_the_match() {
+        assert!(edits_fit(0, 1));
+        assert!(!edits_fit(1, 2));
+        assert!(edits_fit(1, 3));
+        assert!(!edits_fit(2, 4));
+        assert!(edits_fit(2, 5));
+        assert!(edits_fit(3, 8));
     }
 
     #[test]

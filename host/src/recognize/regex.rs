@@ -289,10 +289,12 @@ fn glushkov(r: &Regex, symbols: &mut Vec<Token>, follow: &mut [u64]) -> G {
     }
 }
 
-/// The default edit bound for a pattern whose shortest match has `min_len` tokens: about one
-/// edit per three tokens, at most `MAX_EDITS`, always fewer than `min_len`.
+/// The default edit bound for a pattern whose shortest match has `min_len` tokens: `MAX_EDITS`,
+/// always fewer than `min_len`. The device also holds every match to
+/// `figurine_recognizer::segment::EDIT_SHARE` of the tokens it covers, so a short match gets
+/// few edits and a long performance more.
 pub fn default_edits(min_len: usize) -> u8 {
-    (min_len / 3).min(MAX_EDITS).min(min_len.saturating_sub(1)) as u8
+    MAX_EDITS.min(min_len.saturating_sub(1)) as u8
 }
 
 impl Compiled {
@@ -411,8 +413,9 @@ mod tests {
         assert_eq!(lib.pattern(0).unwrap().min_len(), 3);
         let too_long = vec!["f b"; 17].join(" ");
         assert!(Regex::parse(&too_long).unwrap().compile().is_err());
-        assert_eq!(default_edits(2), 0);
-        assert_eq!(default_edits(3), 1);
+        assert_eq!(default_edits(1), 0);
+        assert_eq!(default_edits(2), 1);
+        assert_eq!(default_edits(3), 2);
         assert_eq!(default_edits(30), 3);
     }
 }
