@@ -32,6 +32,7 @@ use super::library::ActionClip;
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
+use super::variants::{choose_variant, VariantChoice};
 use super::AnimError;
 use crate::events::ActionRecord;
 use crate::motion::{Clip, Pose};
@@ -88,6 +89,8 @@ pub struct Placement {
     pub cycles: usize,
     /// Stages on the log's clock: (stage, start s, end s).
     pub stages: Vec<(Stage, f32, f32)>,
+    /// The clip variant played and why (`None` when the action has a single clip).
+    pub variant: Option<VariantChoice>,
 }
 
 /// The assembled animation and what was done to make it.
@@ -120,8 +123,10 @@ struct Placed {
     src_times: Vec<f32>,
     /// The event's recognised effort.
     effort: Effort,
-    /// The action (key of the clip map).
-    action: String,
+    /// The source clip file of the variant played.
+    file: std::path::PathBuf,
+    /// Seconds of the source file where the played clip starts (see [`ActionClip`]).
+    source_start_s: Option<f32>,
     /// Per frame, per leg: the source clip's foot contact at the frame's source time.
     contacts: Vec<Vec<bool>>,
 }
@@ -239,15 +244,29 @@ pub fn assemble_guided(
     let mut placements: Vec<Placement> = Vec::new();
     let mut last_f1 = 0usize;
     for ev in &evs {
-        let Some(ac) = clips.get(&ev.action) else {
+        let Some(primary) = clips.get(&ev.action) else {
             continue;
         };
+        let effort = Effort {
+            time: ev.time as f32,
+            weight: ev.weight as f32,
+        };
+        let (ac, variant) = choose_variant(
+            primary,
+            crate::graph::effort::Effort {
+                time: effort.time,
+                weight: effort.weight,
+            },
+            guide,
+        );
+        // Caches are per variant.
+        let key = format!("{}\u{0}{}", ev.action, ac.variant);
         let mut f0 = frame_of(ev.start);
         if !placed.is_empty() && f0 < last_f1 {
             f0 = last_f1; // overlapping events: the later one starts when the earlier ends
         }
         let phrasing = phrasings
-            .entry(ev.action.clone())
+            .entry(key.clone())
             .or_insert_with(|| {
                 if ac.cyclic {
                     Phrasing::whole(&ac.clip)
@@ -256,10 +275,6 @@ pub fn assemble_guided(
                 }
             })
             .clone();
-        let effort = Effort {
-            time: ev.time as f32,
-            weight: ev.weight as f32,
-        };
         let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
@@ -275,7 +290,7 @@ pub fn assemble_guided(
         let (poses, world_path, cycles, src_times) =
             place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
         let src_contacts = source_contacts
-            .entry(ev.action.clone())
+            .entry(key)
             .or_insert_with(|| detect_contacts(&ac.clip, &legs))
             .clone();
         let contacts = src_times
@@ -306,6 +321,7 @@ pub fn assemble_guided(
             moving: ac.moving,
             cycles,
             stages,
+            variant,
         });
         placed.push(Placed {
             f0,
@@ -313,7 +329,8 @@ pub fn assemble_guided(
             contacts,
             src_times,
             effort,
-            action: ev.action.clone(),
+            file: ac.file.clone(),
+            source_start_s: ac.source_start_s,
         });
         last_f1 = f1;
     }
@@ -328,20 +345,15 @@ pub fn assemble_guided(
     for w in placed.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         let graph_cut = guide.and_then(|g| {
-            let src = |p: &'_ Placed| {
-                let ac = clips.get(&p.action)?;
-                Some((ac.file.clone(), ac.source_start_s))
-            };
-            let ((fa, sa), (fb, sb)) = (src(a)?, src(b)?);
             let pa = PlacedSource {
-                file: &fa,
-                source_start_s: sa,
+                file: &a.file,
+                source_start_s: a.source_start_s,
                 f0: a.f0,
                 src_times: &a.src_times,
             };
             let pb = PlacedSource {
-                file: &fb,
-                source_start_s: sb,
+                file: &b.file,
+                source_start_s: b.source_start_s,
                 f0: b.f0,
                 src_times: &b.src_times,
             };
@@ -556,13 +568,35 @@ fn place_action(
     } else {
         0.0
     };
+    // Looping in place: cycle k starts where cycle k − 1 ended, i.e. cycle k is the clip
+    // turned by k × the clip's own yaw per cycle and shifted by the sum of the earlier cycles'
+    // ground displacements (zero for anchored clips), so the root never snaps back.
+    let loop_turn = Quat::from_rotation_y(if cycles > 1 {
+        let a = ground(q0 * forward).normalize_or(Vec2::X);
+        let b = ground(ql * forward).normalize_or(Vec2::X);
+        super::trajectory::yaw(b) - super::trajectory::yaw(a)
+    } else {
+        0.0
+    });
+    let loop_step = if ac.anchor {
+        Vec2::ZERO
+    } else {
+        ground(rl - r0)
+    };
+    let mut loop_frames: Vec<(Vec2, Quat)> = Vec::with_capacity(cycles.max(1));
+    let (mut off, mut turn) = (Vec2::ZERO, Quat::IDENTITY);
+    for _ in 0..cycles.max(1) {
+        loop_frames.push((off, turn));
+        off += rot2(turn, loop_step);
+        turn = (loop_turn * turn).normalize();
+    }
     let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
     let mut sigma_max = 0.0f32;
     let mut poses = Vec::with_capacity(n + 1);
     let mut src_times = Vec::with_capacity(n + 1);
     for k in 0..=n {
         let u = k as f32 / n.max(1) as f32;
-        let (w, cycle) = if ac.cyclic {
+        let (w, cycle) = if cycles > 1 {
             let uc = u * cycles as f32;
             let c = (uc.floor() as usize).min(cycles - 1);
             (uc - c as f32, c)
@@ -576,11 +610,18 @@ fn place_action(
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
             let drift = if ac.anchor {
-                ground(rl - r0) * (ec.source_time(w) / clip.duration().max(1e-6))
+                ground(rl - r0) * (src_t / clip.duration().max(1e-6))
             } else {
                 Vec2::ZERO
             };
-            (base + rot2(r_start, ground(r - r0) - drift), r_start)
+            let (off, turn) = loop_frames
+                .get(cycle)
+                .copied()
+                .unwrap_or((Vec2::ZERO, Quat::IDENTITY));
+            (
+                base + rot2(r_start, off + rot2(turn, ground(r - r0) - drift)),
+                r_start * turn,
+            )
         } else if ac.cyclic {
             let s = (cycle as f32 * cycle_len + along(r - r0)) * stretch;
             let tangent = chunk.tangent_at(s, 0.3).unwrap_or(start_heading);
@@ -624,7 +665,9 @@ fn place_action(
 
 /// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
 /// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
-/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put); 1 otherwise.
+/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put). A looping clip that
+/// plays in place (or a cyclic one without a path to follow) repeats as many whole times as
+/// fill the duration at its own speed. 1 otherwise (moving, non-cyclic actions play once).
 fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
     let root = ec.clip.root_path();
     let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
@@ -635,6 +678,8 @@ fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32
         let by_path = (chunk.length() / cycle_len).round() as usize;
         let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
         by_path.min(by_time).max(1)
+    } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {
+        (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
     } else {
         1
     }

@@ -255,8 +255,24 @@ fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
             .iter()
             .map(|(s, a, b)| format!("{s} {a:.2}-{b:.2}"))
             .collect();
+        let variant = p
+            .variant
+            .as_ref()
+            .map(|v| {
+                format!(
+                    "  variant {} ({}/{}, effort Lt {:+.2} Lw {:+.2} by {}, match {:.2})",
+                    v.name,
+                    v.index + 1,
+                    v.of,
+                    v.variant_effort.time,
+                    v.variant_effort.weight,
+                    if v.by_graph { "graph" } else { "clip" },
+                    v.effort_match
+                )
+            })
+            .unwrap_or_default();
         println!(
-            "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]",
+            "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]{variant}",
             p.action,
             asm.t_origin as f32 + p.start_frame as f32 * c.frame_time,
             asm.t_origin as f32 + p.end_frame as f32 * c.frame_time,

@@ -15,6 +15,21 @@
 //! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
 //! `scale` turns a BVH clip's unit into metres (default
 //! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces in its clips.
+//!
+//! **Variants.** An action may instead list several clips, e.g. a plain kick and a spinning
+//! kick: `"kick": [ {"name": "kick", "file": …}, {"name": "spinkick", "file": …} ]`. Each
+//! element is a clip object as above plus an optional `name` (default: the file's stem, with
+//! its frame range). The assembler plays the variant whose Effort-component LMA features best
+//! match the action's recognised Laban Time and Weight (see [`super::variants`]); the first
+//! variant is the action's primary clip (the one shown by `figurine clip`, and the tie winner).
+//! A list must hold 1 to [`MAX_VARIANTS`] clips with distinct names that agree on `moving`;
+//! anything else is an error naming the file and line. A single clip object is a list of one,
+//! so older libraries read unchanged.
+//!
+//! **Loops.** `loop` says whether the clip may be repeated seamlessly when an action lasts
+//! longer than it (the root carried forward by the clip's own per-cycle displacement and
+//! turn). Default: DeepMimic's `"Loop": "wrap"` for a whole DeepMimic file (no `frames`, no
+//! `pingpong`), `cyclic` otherwise. Moving actions that are not cyclic (jumps) play once.
 //! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
 //! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
 //! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
@@ -24,12 +39,16 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use serde::Deserialize;
+use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer};
 
 use super::AnimError;
 use crate::motion::deepmimic::{humanoid_skeleton, read_deepmimic};
 use crate::motion::urdf::read_urdf_path;
 use crate::motion::{read_bvh_path, Clip, Skeleton};
+
+/// Most clip variants one action may list.
+pub const MAX_VARIANTS: usize = 16;
 
 /// The built-in default library text.
 pub const DEFAULT_LIBRARY: &str = include_str!("../../assets/default_clips.json");
@@ -38,6 +57,9 @@ pub const DEFAULT_LIBRARY: &str = include_str!("../../assets/default_clips.json"
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ActionSpec {
+    /// Variant name (unique within the action; default: the file stem and frame range).
+    #[serde(default)]
+    pub name: Option<String>,
     /// Clip file: relative to the library, or `KIND/NAME` in the data folder.
     pub file: String,
     /// Whether the character travels along the doodle (false: in place, §6.2).
@@ -58,9 +80,106 @@ pub struct ActionSpec {
     /// Length unit → metres for BVH clips (default 0.01).
     #[serde(default)]
     pub scale: Option<f32>,
+    /// Whether the clip repeats seamlessly when the action outlasts it (default: the DeepMimic
+    /// file's `"Loop": "wrap"` for whole files, else `cyclic`).
+    #[serde(default, rename = "loop")]
+    pub looping: Option<bool>,
     /// Why this clip was chosen (substitutions are documented here).
     #[serde(default)]
     pub note: Option<String>,
+}
+
+impl ActionSpec {
+    /// The variant's name: `name`, else the file stem (without DeepMimic's `humanoid3d_`) and
+    /// its frame range.
+    pub fn variant_name(&self) -> String {
+        if let Some(n) = &self.name {
+            return n.clone();
+        }
+        let stem = Path::new(&self.file)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| self.file.clone());
+        let stem = stem.strip_prefix("humanoid3d_").unwrap_or(&stem).to_string();
+        match self.frames {
+            Some([a, b]) => format!("{stem}[{a}-{b}]"),
+            None => stem,
+        }
+    }
+}
+
+/// The clips of one action: one or more variants (the first is the primary clip).
+#[derive(Debug, Clone)]
+pub struct ActionEntry {
+    /// The variants in library order (never empty, at most [`MAX_VARIANTS`]).
+    pub variants: Vec<ActionSpec>,
+}
+
+impl ActionEntry {
+    /// The primary (first) variant.
+    pub fn primary(&self) -> Option<&ActionSpec> {
+        self.variants.first()
+    }
+}
+
+impl<'de> Deserialize<'de> for ActionEntry {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct EntryVisitor;
+        impl<'de> Visitor<'de> for EntryVisitor {
+            type Value = ActionEntry;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a clip object or a list of clip objects (variants)")
+            }
+
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ActionEntry, A::Error> {
+                let spec =
+                    ActionSpec::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(ActionEntry {
+                    variants: vec![spec],
+                })
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<ActionEntry, A::Error> {
+                let variants = Vec::<ActionSpec>::deserialize(
+                    serde::de::value::SeqAccessDeserializer::new(seq),
+                )?;
+                check_variants(&variants).map_err(A::Error::custom)?;
+                Ok(ActionEntry { variants })
+            }
+        }
+        d.deserialize_any(EntryVisitor)
+    }
+}
+
+/// Rules of a variant list: 1..=MAX_VARIANTS clips, distinct names, one `moving`.
+fn check_variants(variants: &[ActionSpec]) -> Result<(), String> {
+    if variants.is_empty() {
+        return Err("empty variant list: an action needs at least one clip".into());
+    }
+    if variants.len() > MAX_VARIANTS {
+        return Err(format!(
+            "{} variants: at most {MAX_VARIANTS} clips per action",
+            variants.len()
+        ));
+    }
+    let mut names: Vec<String> = Vec::with_capacity(variants.len());
+    for v in variants {
+        let n = v.variant_name();
+        if names.contains(&n) {
+            return Err(format!(
+                "two variants are named {n:?}: give each a distinct \"name\""
+            ));
+        }
+        names.push(n);
+    }
+    if variants.iter().any(|v| v.moving != variants[0].moving) {
+        return Err(
+            "variants disagree on \"moving\": all clips of one action must travel, or none"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// Where the skeleton of DeepMimic clips comes from.
@@ -85,8 +204,8 @@ pub struct ClipLibrary {
     /// Direction the rig faces in its clips (rig space, horizontal).
     #[serde(default = "default_forward")]
     pub forward: [f32; 3],
-    /// Action name → clip.
-    pub actions: BTreeMap<String, ActionSpec>,
+    /// Action name → its clip variants.
+    pub actions: BTreeMap<String, ActionEntry>,
     /// Folder relative paths resolve against (the library file's folder).
     #[serde(skip)]
     pub base: Option<PathBuf>,
@@ -99,17 +218,21 @@ fn default_forward() -> [f32; 3] {
     [1.0, 0.0, 0.0]
 }
 
-/// A clip ready for assembly.
+/// A clip ready for assembly (one variant of an action).
 #[derive(Debug, Clone)]
 pub struct ActionClip {
     /// Action name.
     pub action: String,
+    /// Variant name (see [`ActionSpec::variant_name`]).
+    pub variant: String,
     /// The clip in metres, +Y up.
     pub clip: Clip,
     /// Travels along the doodle.
     pub moving: bool,
     /// Repeats in cycles.
     pub cyclic: bool,
+    /// Repeats seamlessly when the action outlasts the clip (see the module doc).
+    pub looping: bool,
     /// In place and anchored: the clip's net ground drift is removed.
     pub anchor: bool,
     /// The source clip file it was cut from (for motion-graph look-ups).
@@ -117,6 +240,21 @@ pub struct ActionClip {
     /// Seconds of the source file where this clip starts (its `frames` range); `None` when
     /// played ping-pong (its time then has no monotone map to the source's).
     pub source_start_s: Option<f32>,
+    /// Seconds of the source file the clip was cut from, (first, last) frame.
+    pub source_span_s: (f32, f32),
+    /// The variant's own Laban effort estimate from its Effort-component LMA features,
+    /// standardised over the action's variants (`None` when the action has one clip).
+    pub effort: Option<crate::graph::effort::Effort>,
+    /// The action's other variants, in library order (empty for a single clip). `self` is the
+    /// primary variant.
+    pub alternatives: Vec<ActionClip>,
+}
+
+impl ActionClip {
+    /// All variants: `self` first, then the alternatives.
+    pub fn variants(&self) -> impl Iterator<Item = &ActionClip> {
+        std::iter::once(self).chain(self.alternatives.iter())
+    }
 }
 
 impl ClipLibrary {
@@ -231,7 +369,9 @@ impl ClipLibrary {
         Ok(Some((sk, urdf)))
     }
 
-    /// Loads the clips of the given actions (all must be mapped, see [`Self::check_actions`]).
+    /// Loads the clips of the given actions (all must be mapped, see [`Self::check_actions`]):
+    /// each action's primary variant, carrying the others as
+    /// [`ActionClip::alternatives`] with their effort estimates.
     pub fn load<'a>(
         &self,
         actions: impl IntoIterator<Item = &'a str>,
@@ -245,67 +385,111 @@ impl ClipLibrary {
             if out.contains_key(action) {
                 continue;
             }
-            let Some(spec) = self.actions.get(action) else {
+            let Some(entry) = self.actions.get(action) else {
                 continue;
             };
-            let path = self.resolve(&spec.file)?;
-            let mut clip = if path
-                .extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
-            {
-                let mut c = read_bvh_path(&path)?.clip;
-                c.scale_lengths(spec.scale.unwrap_or(0.01));
-                c
-            } else {
-                let (sk, u) = urdf.as_ref().ok_or_else(|| {
+            check_variants(&entry.variants).map_err(|reason| AnimError::Spec {
+                path: PathBuf::from(&self.origin),
+                line: 1,
+                reason: format!("action {action}: {reason}"),
+            })?;
+            let mut loaded = Vec::with_capacity(entry.variants.len());
+            for spec in &entry.variants {
+                let ac = self.load_variant(action, spec, urdf.as_ref())?;
+                let joint_names: Vec<String> = ac
+                    .clip
+                    .skeleton
+                    .joints
+                    .iter()
+                    .map(|j| j.name.clone())
+                    .collect();
+                match &names {
+                    None => names = Some(joint_names),
+                    Some(n) if *n != joint_names => {
+                        return Err(AnimError::Data(format!(
+                            "{}: clip for {action} ({}) has a different skeleton from the other clips",
+                            self.origin, spec.file
+                        )))
+                    }
+                    Some(_) => {}
+                }
+                loaded.push(ac);
+            }
+            if loaded.len() > 1 {
+                super::variants::sign_variants(&mut loaded).map_err(|e| {
                     AnimError::Data(format!(
-                        "{}: DeepMimic clip {} needs a \"skeleton\" entry",
-                        self.origin, spec.file
+                        "{}: action {action}: effort features of its variants: {e}",
+                        self.origin
                     ))
                 })?;
-                let text = std::fs::read_to_string(&path).map_err(|e| AnimError::Io {
-                    path: path.clone(),
-                    reason: e.to_string(),
-                })?;
-                let mut c = read_deepmimic(&text, &path, sk, u)?.clip;
-                c.scale_lengths(spec.scale.unwrap_or(1.0));
-                c
-            };
-            clip.name = action.to_string();
-            let source_start_s = (!spec.pingpong)
-                .then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
-            select_frames(&mut clip, spec, &self.origin, action)?;
-            let joint_names: Vec<String> = clip
-                .skeleton
-                .joints
-                .iter()
-                .map(|j| j.name.clone())
-                .collect();
-            match &names {
-                None => names = Some(joint_names),
-                Some(n) if *n != joint_names => {
-                    return Err(AnimError::Data(format!(
-                        "{}: clip for {action} ({}) has a different skeleton from the other clips",
-                        self.origin, spec.file
-                    )))
-                }
-                Some(_) => {}
             }
-            out.insert(
-                action.to_string(),
-                ActionClip {
-                    action: action.to_string(),
-                    clip,
-                    moving: spec.moving,
-                    cyclic: spec.cyclic,
-                    anchor: spec.anchor && !spec.moving,
-                    file: path,
-                    source_start_s,
-                },
-            );
+            let mut it = loaded.into_iter();
+            if let Some(mut primary) = it.next() {
+                primary.alternatives = it.collect();
+                out.insert(action.to_string(), primary);
+            }
         }
         Ok(out)
+    }
+
+    /// Loads one variant's clip.
+    fn load_variant(
+        &self,
+        action: &str,
+        spec: &ActionSpec,
+        urdf: Option<&(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>,
+    ) -> Result<ActionClip, AnimError> {
+        let path = self.resolve(&spec.file)?;
+        let is_bvh = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
+        let (mut clip, file_loops) = if is_bvh {
+            let mut c = read_bvh_path(&path)?.clip;
+            c.scale_lengths(spec.scale.unwrap_or(0.01));
+            (c, false)
+        } else {
+            let (sk, u) = urdf.ok_or_else(|| {
+                AnimError::Data(format!(
+                    "{}: DeepMimic clip {} needs a \"skeleton\" entry",
+                    self.origin, spec.file
+                ))
+            })?;
+            let text = std::fs::read_to_string(&path).map_err(|e| AnimError::Io {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
+            let dm = read_deepmimic(&text, &path, sk, u)?;
+            let mut c = dm.clip;
+            c.scale_lengths(spec.scale.unwrap_or(1.0));
+            (c, dm.looping)
+        };
+        clip.name = action.to_string();
+        let source_start_s = (!spec.pingpong)
+            .then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
+        let source_span_s = match spec.frames {
+            Some([a, b]) => (a as f32 * clip.frame_time, b as f32 * clip.frame_time),
+            None => (0.0, clip.duration()),
+        };
+        select_frames(&mut clip, spec, &self.origin, action)?;
+        let whole = spec.frames.is_none() && !spec.pingpong;
+        let looping = spec
+            .looping
+            .unwrap_or(spec.cyclic || (whole && file_loops));
+        Ok(ActionClip {
+            action: action.to_string(),
+            variant: spec.variant_name(),
+            clip,
+            moving: spec.moving,
+            cyclic: spec.cyclic,
+            looping: looping || spec.cyclic,
+            anchor: spec.anchor && !spec.moving,
+            file: path,
+            source_start_s,
+            source_span_s,
+            effort: None,
+            alternatives: Vec::new(),
+        })
     }
 }
 
@@ -366,6 +550,88 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("lib.json:4:"), "{err}");
+    }
+
+    #[test]
+    fn single_clip_libraries_still_read() {
+        let text = r#"{ "version": 1, "actions": {
+            "walk": { "file": "w.bvh", "moving": true, "cyclic": true },
+            "hop":  { "file": "h.bvh", "moving": true, "cyclic": false, "frames": [3, 9] } } }"#;
+        let lib = ClipLibrary::parse(text, Path::new("old.json"), None).unwrap();
+        assert_eq!(lib.actions["walk"].variants.len(), 1);
+        let hop = lib.actions["hop"].primary().unwrap();
+        assert_eq!(hop.variant_name(), "h[3-9]");
+        assert_eq!(hop.looping, None);
+    }
+
+    #[test]
+    fn variant_lists_read_in_order() {
+        let text = r#"{ "version": 1, "actions": {
+            "kick": [ { "file": "deepmimic/humanoid3d_kick.txt", "moving": false, "cyclic": false },
+                      { "name": "spin", "file": "deepmimic/humanoid3d_spinkick.txt",
+                        "moving": false, "cyclic": false, "loop": false } ] } }"#;
+        let lib = ClipLibrary::parse(text, Path::new("v.json"), None).unwrap();
+        let names: Vec<String> = lib.actions["kick"]
+            .variants
+            .iter()
+            .map(ActionSpec::variant_name)
+            .collect();
+        assert_eq!(names, ["kick", "spin"]);
+        assert_eq!(lib.actions["kick"].variants[1].looping, Some(false));
+    }
+
+    #[test]
+    fn malformed_variant_lists_name_file_and_line() {
+        let clip = r#"{ "file": "a.bvh", "moving": false, "cyclic": false }"#;
+        let moving = r#"{ "file": "b.bvh", "moving": true, "cyclic": false }"#;
+        let many = vec![clip; MAX_VARIANTS + 1].join(",");
+        let cases = [
+            ("[]".to_string(), "empty variant list"),
+            (format!("[{clip}, {clip}]"), "two variants are named \"a\""),
+            (format!("[{clip}, {moving}]"), "disagree on \"moving\""),
+            (format!("[{clip}, 3]"), "expected struct ActionSpec"),
+            (format!("[{clip}, {{\"file\": \"x.bvh\"}}]"), "missing field `moving`"),
+            ("\"walk.bvh\"".to_string(), "a clip object or a list of clip objects"),
+            (format!("[{many}]"), "at most 16 clips"),
+        ];
+        for (entry, want) in cases {
+            let text = format!("{{\n\"version\": 1,\n\"actions\": {{\n\"kick\": {entry}\n}}\n}}");
+            let err = ClipLibrary::parse(&text, Path::new("bad.json"), None)
+                .unwrap_err()
+                .to_string();
+            assert!(err.starts_with("bad.json:4:"), "{entry}: {err}");
+            assert!(err.contains(want), "{entry}: {err}");
+        }
+    }
+
+    #[test]
+    fn default_kick_variants_follow_the_effort() {
+        if crate::data::data_file("deepmimic", "humanoid.urdf").is_none() {
+            eprintln!("skipping: deepmimic data missing — run `cargo xtask setup`");
+            return;
+        }
+        let lib = ClipLibrary::default_library().unwrap();
+        let clips = lib.load(["kick", "punch"]).unwrap();
+        let kick = &clips["kick"];
+        let names: Vec<&str> = kick.variants().map(|v| v.variant.as_str()).collect();
+        assert_eq!(names, ["kick", "spinkick"]);
+        assert!(!kick.alternatives[0].looping, "spinkick has loop: false");
+        assert!(clips["punch"].alternatives.is_empty() && clips["punch"].effort.is_none());
+        let e = |t: f32, w: f32| crate::graph::effort::Effort { time: t, weight: w };
+        let pick = |t, w| {
+            super::super::variants::choose_variant(kick, e(t, w), None)
+                .0
+                .variant
+                .clone()
+        };
+        assert_eq!(pick(0.8, 0.8), "spinkick");
+        assert_eq!(pick(-0.8, -0.8), "kick");
+        // Stable: a second load decides the same.
+        let again = lib.load(["kick"]).unwrap();
+        let (v, c) =
+            super::super::variants::choose_variant(&again["kick"], e(0.8, 0.8), None);
+        assert_eq!(v.variant, "spinkick");
+        assert_eq!(c.unwrap().variant_effort, kick.alternatives[0].effort.unwrap());
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! doodle's path to a full-body character animation.
 //!
 //! Data flow, one file per stage:
-//! [`library`] (action → clip) → [`phrasing`] (stages of each clip, §6.1) →
+//! [`library`] (action → clip variants) → [`variants`] (the variant matching the recognised
+//! effort) → [`phrasing`] (stages of each clip, §6.1) →
 //! [`effort`] (retime eq. 6, rescale eq. 7, weight arc length, reshape; §6.3–6.4) →
 //! [`trajectory`] (doodle → ground path, in-place offsets, cycles, jumps; §6.2) →
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
@@ -26,6 +27,7 @@ pub mod phrasing;
 pub mod plot;
 pub mod trajectory;
 pub mod transition;
+pub mod variants;
 
 /// Why an animation could not be assembled.
 #[derive(Debug, Error)]
