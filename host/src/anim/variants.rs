@@ -13,8 +13,11 @@
 //! With a motion graph (`figurine animate --graph G.bin`) whose clips include every variant's
 //! source file, the graph's own estimates are used instead (standardised over the graph's
 //! library, over the variant's frame range: [`rank_spans_by_effort`]); otherwise the clip-based
-//! ones. The variant with the best match `1 − (|ΔLt| + |ΔLw|)/4` wins; ties go to the earlier
-//! variant in the library, so the choice is deterministic.
+//! ones. The variant with the best match `1 − (|ΔLt| + |ΔLw|)/4` wins, but the primary (first)
+//! variant is kept unless another beats it by [`VARIANT_MARGIN`] — a neutral effort, halfway
+//! between a sustained and a sudden variant, plays the library's default clip rather than
+//! whichever side rounding favours. Ties go to the earlier variant, so the choice is
+//! deterministic.
 
 use std::path::Path;
 
@@ -27,6 +30,10 @@ use crate::graph::source::prepare;
 use crate::graph::style::Standardiser;
 use crate::graph::{GraphError, Role, WINDOW};
 use crate::motion::Clip;
+
+/// How much better (in match units, [0, 1]) another variant must match the recognised effort
+/// than the primary to replace it (0.05 = a summed |ΔLt| + |ΔLw| of 0.2).
+pub const VARIANT_MARGIN: f32 = 0.05;
 
 /// Which variant of an action was played, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,15 +151,15 @@ pub fn choose_variant<'a>(
             );
         }
     }
-    let mut best: Option<(usize, f32, Effort)> = None;
-    for (i, v) in all.iter().enumerate() {
-        let e = v.effort.unwrap_or_default();
-        let m = e.matches(&want);
-        if best.is_none_or(|(_, bm, _)| m > bm) {
-            best = Some((i, m, e));
-        }
-    }
-    let (i, m, e) = best.unwrap_or((0, 0.0, Effort::default()));
+    let scored: Vec<(usize, f32, Effort)> = all
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let e = v.effort.unwrap_or_default();
+            (i, e.matches(&want), e)
+        })
+        .collect();
+    let (i, m, e) = pick(&scored).unwrap_or((0, 0.0, Effort::default()));
     (
         all[i],
         Some(VariantChoice {
@@ -184,9 +191,27 @@ fn graph_choice(
     if ranked.len() != all.len() {
         return None;
     }
-    let &(i, m) = ranked.first()?;
-    let (c, r) = spans.get(i)?;
-    Some((i, m, g.clip_effort_between(*c, r.clone())?))
+    let scored: Vec<(usize, f32, Effort)> = ranked
+        .iter()
+        .map(|&(i, m)| {
+            let (c, r) = spans.get(i)?;
+            Some((i, m, g.clip_effort_between(*c, r.clone())?))
+        })
+        .collect::<Option<_>>()?;
+    pick(&scored)
+}
+
+/// The best-matching (index, match, effort), keeping index 0 (the primary) unless another
+/// beats it by [`VARIANT_MARGIN`]; ties to the lower index.
+fn pick(scored: &[(usize, f32, Effort)]) -> Option<(usize, f32, Effort)> {
+    let best = scored
+        .iter()
+        .copied()
+        .min_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)))?;
+    match scored.iter().find(|s| s.0 == 0) {
+        Some(&primary) if best.1 < primary.1 + VARIANT_MARGIN => Some(primary),
+        _ => Some(best),
+    }
 }
 
 #[cfg(test)]
@@ -316,6 +341,13 @@ mod tests {
         };
         let (_, c) = choose_variant(&punch, nan, None);
         assert!(c.unwrap().effort_match.is_finite());
+        // The primary stays unless another variant is clearly better.
+        let scored = |m1: f32| {
+            let e = Effort::default();
+            pick(&[(0, 0.6, e), (1, m1, e), (2, 0.1, e)]).unwrap().0
+        };
+        assert_eq!(scored(0.6 + VARIANT_MARGIN / 2.0), 0);
+        assert_eq!(scored(0.6 + 2.0 * VARIANT_MARGIN), 1);
     }
 
     #[test]

@@ -1,0 +1,235 @@
+//! Clip variants chosen by the recognised effort, and looping clips wrapped seamlessly when an
+//! action outlasts its clip.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use figurine_host::anim::assemble::{assemble, AssembleOptions, Assembly};
+use figurine_host::anim::library::{ActionClip, ClipLibrary};
+use figurine_host::events::ActionRecord;
+use figurine_host::motion::{Clip, Joint, Pose, Skeleton};
+use glam::{Vec2, Vec3};
+
+fn have_data() -> bool {
+    if figurine_host::data::data_file("deepmimic", "humanoid.urdf").is_none() {
+        eprintln!("skipping: deepmimic data missing — run `cargo xtask setup`");
+        return false;
+    }
+    true
+}
+
+fn event(action: &str, start: f64, end: f64, time: f64, weight: f64) -> ActionRecord {
+    ActionRecord {
+        action: action.into(),
+        start,
+        end,
+        time,
+        weight,
+        distance: 0,
+    }
+}
+
+fn run(lib: &ClipLibrary, events: &[ActionRecord]) -> Assembly {
+    let clips = lib
+        .load(events.iter().map(|e| e.action.as_str()))
+        .unwrap();
+    assemble(
+        events,
+        None,
+        &clips,
+        lib.forward(),
+        &AssembleOptions::default(),
+    )
+    .unwrap()
+}
+
+/// Root ground positions of frames `a..=b`.
+fn root_path(asm: &Assembly, a: usize, b: usize) -> Vec<Vec2> {
+    asm.clip.frames[a..=b]
+        .iter()
+        .map(|p| Vec2::new(p.translations[0].x, p.translations[0].z))
+        .collect()
+}
+
+/// Largest backwards step along `dir` and largest step length between consecutive frames, m.
+fn steps(path: &[Vec2], dir: Vec2) -> (f32, f32) {
+    let mut back = 0.0f32;
+    let mut longest = 0.0f32;
+    for w in path.windows(2) {
+        let d = w[1] - w[0];
+        back = back.max(-d.dot(dir));
+        longest = longest.max(d.length());
+    }
+    (back, longest)
+}
+
+#[test]
+fn sudden_strong_and_sustained_light_kicks_play_different_variants() {
+    if !have_data() {
+        return;
+    }
+    let lib = ClipLibrary::default_library().unwrap();
+    let events = [
+        event("kick", 0.0, 1.6, 0.8, 0.8),
+        event("kick", 2.5, 4.1, -0.8, -0.8),
+        event("punch", 5.0, 6.0, 0.8, 0.8),
+    ];
+    let asm = run(&lib, &events);
+    let v: Vec<Option<String>> = asm
+        .placements
+        .iter()
+        .map(|p| p.variant.as_ref().map(|v| v.name.clone()))
+        .collect();
+    assert_eq!(
+        v,
+        [Some("spinkick".into()), Some("kick".into()), None],
+        "variants played"
+    );
+    let strong = asm.placements[0].variant.as_ref().unwrap();
+    let light = asm.placements[1].variant.as_ref().unwrap();
+    assert!(strong.variant_effort.time > 0.0 && strong.variant_effort.weight > 0.0);
+    assert!(light.variant_effort.time < 0.0 && light.variant_effort.weight < 0.0);
+    // Deterministic: the same events give the same animation, bit for bit.
+    let again = run(&lib, &events);
+    assert_eq!(asm.clip.frames, again.clip.frames);
+}
+
+#[test]
+fn a_long_walk_wraps_its_cycle_forward() {
+    if !have_data() {
+        return;
+    }
+    let lib = ClipLibrary::default_library().unwrap();
+    let asm = run(&lib, &[event("walk", 0.0, 6.0, 0.0, 0.0)]);
+    let p = &asm.placements[0];
+    assert!(p.cycles >= 4, "{} cycles in 6 s", p.cycles);
+    let path = root_path(&asm, p.start_frame, p.end_frame);
+    let (back, longest) = steps(&path, Vec2::X);
+    assert!(back < 1e-3, "root steps back {back} m along the walk");
+    assert!(longest < 0.1, "root jumps {longest} m in one frame");
+    let travel = path[path.len() - 1].x - path[0].x;
+    assert!(
+        travel > 1.0 * p.cycles as f32,
+        "{travel} m in {} cycles",
+        p.cycles
+    );
+}
+
+/// A library playing DeepMimic's looping walk on the spot (not along a path), with and
+/// without its loop.
+fn march_library(dir: &Path) -> ClipLibrary {
+    let text = r#"{ "version": 1,
+      "skeleton": { "format": "deepmimic-urdf", "file": "deepmimic/humanoid.urdf" },
+      "actions": {
+        "march": { "file": "deepmimic/humanoid3d_walk.txt", "moving": false, "cyclic": false },
+        "march_once": { "file": "deepmimic/humanoid3d_walk.txt", "moving": false,
+                        "cyclic": false, "loop": false } } }"#;
+    let p = dir.join("march.json");
+    std::fs::write(&p, text).unwrap();
+    ClipLibrary::read_path(&p).unwrap()
+}
+
+#[test]
+fn a_looping_clip_in_place_continues_from_where_it_ended() {
+    if !have_data() {
+        return;
+    }
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("animate_variants");
+    std::fs::create_dir_all(&dir).unwrap();
+    let lib = march_library(&dir);
+    let asm = run(&lib, &[event("march", 0.0, 4.0, 0.0, 0.0)]);
+    let p = &asm.placements[0];
+    assert_eq!(p.cycles, 3, "4 s of a 1.27 s loop");
+    let path = root_path(&asm, p.start_frame, p.end_frame);
+    let (back, longest) = steps(&path, Vec2::X);
+    assert!(back < 1e-3, "root steps back {back} m across a wrap");
+    assert!(longest < 0.1, "root jumps {longest} m in one frame");
+    let travel = path[path.len() - 1].x - path[0].x;
+    assert!(travel > 3.0 * 1.1, "three cycles carried forward: {travel} m");
+    // `"loop": false`: one cycle, slowed down to fill the action.
+    let once = run(&lib, &[event("march_once", 0.0, 4.0, 0.0, 0.0)]);
+    assert_eq!(once.placements[0].cycles, 1);
+}
+
+/// A looping clip built in code: the root advances 1 m per cycle along +X with a bob, and
+/// turns nothing; `frames` frames at 30 fps.
+fn synthetic_loop(frames: usize) -> ActionClip {
+    let j = Joint::bare;
+    let skeleton = Skeleton {
+        joints: vec![
+            j("root", None, Vec3::ZERO),
+            j("spine", Some(0), Vec3::new(0.0, 0.5, 0.0)),
+        ],
+    };
+    let frames: Vec<Pose> = (0..frames)
+        .map(|k| {
+            let u = k as f32 / (frames - 1) as f32;
+            let mut p = Pose::rest(&skeleton);
+            // Uneven progress within the cycle (fast then slow), like a stride.
+            let x = u + 0.1 * (std::f32::consts::TAU * u).sin();
+            p.translations[0] = Vec3::new(
+                x,
+                0.9 + 0.03 * (std::f32::consts::TAU * 2.0 * u).cos(),
+                0.0,
+            );
+            p
+        })
+        .collect();
+    let clip = Clip {
+        name: "stride".into(),
+        skeleton,
+        frame_time: 1.0 / 30.0,
+        frames,
+    };
+    ActionClip {
+        action: "stride".into(),
+        variant: "stride".into(),
+        moving: false,
+        cyclic: false,
+        looping: true,
+        anchor: false,
+        file: PathBuf::from("stride.bvh"),
+        source_start_s: Some(0.0),
+        source_span_s: (0.0, clip.duration()),
+        clip,
+        effort: None,
+        alternatives: Vec::new(),
+    }
+}
+
+#[test]
+fn a_synthetic_loop_wraps_without_snapping_back() {
+    let mut clips = BTreeMap::new();
+    clips.insert("stride".to_string(), synthetic_loop(31));
+    let asm = assemble(
+        &[event("stride", 0.0, 4.0, 0.0, 0.0)],
+        None,
+        &clips,
+        Vec3::X,
+        &AssembleOptions::default(),
+    )
+    .unwrap();
+    let p = &asm.placements[0];
+    assert_eq!(p.cycles, 4, "4 s of a 1 s loop");
+    let path = root_path(&asm, p.start_frame, p.end_frame);
+    let (back, longest) = steps(&path, Vec2::X);
+    assert!(back < 1e-4, "root steps back {back} m");
+    assert!(longest < 0.1, "root jumps {longest} m in one frame");
+    let travel = path[path.len() - 1].x - path[0].x;
+    assert!((travel - 4.0).abs() < 0.05, "4 cycles of 1 m: {travel} m");
+    // Without the loop the same event plays the clip once, slowly.
+    let mut once = synthetic_loop(31);
+    once.looping = false;
+    clips.insert("stride".to_string(), once);
+    let slow = assemble(
+        &[event("stride", 0.0, 4.0, 0.0, 0.0)],
+        None,
+        &clips,
+        Vec3::X,
+        &AssembleOptions::default(),
+    )
+    .unwrap();
+    let p = &slow.placements[0];
+    let path = root_path(&slow, p.start_frame, p.end_frame);
+    assert!((path[path.len() - 1].x - path[0].x - 1.0).abs() < 0.05);
+}
