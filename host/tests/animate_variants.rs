@@ -30,9 +30,7 @@ fn event(action: &str, start: f64, end: f64, time: f64, weight: f64) -> ActionRe
 }
 
 fn run(lib: &ClipLibrary, events: &[ActionRecord]) -> Assembly {
-    let clips = lib
-        .load(events.iter().map(|e| e.action.as_str()))
-        .unwrap();
+    let clips = lib.load(events.iter().map(|e| e.action.as_str())).unwrap();
     assemble(
         events,
         None,
@@ -145,7 +143,10 @@ fn a_looping_clip_in_place_continues_from_where_it_ended() {
     assert!(back < 1e-3, "root steps back {back} m across a wrap");
     assert!(longest < 0.1, "root jumps {longest} m in one frame");
     let travel = path[path.len() - 1].x - path[0].x;
-    assert!(travel > 3.0 * 1.1, "three cycles carried forward: {travel} m");
+    assert!(
+        travel > 3.0 * 1.1,
+        "three cycles carried forward: {travel} m"
+    );
     // `"loop": false`: one cycle, slowed down to fill the action.
     let once = run(&lib, &[event("march_once", 0.0, 4.0, 0.0, 0.0)]);
     assert_eq!(once.placements[0].cycles, 1);
@@ -167,11 +168,8 @@ fn synthetic_loop(frames: usize) -> ActionClip {
             let mut p = Pose::rest(&skeleton);
             // Uneven progress within the cycle (fast then slow), like a stride.
             let x = u + 0.1 * (std::f32::consts::TAU * u).sin();
-            p.translations[0] = Vec3::new(
-                x,
-                0.9 + 0.03 * (std::f32::consts::TAU * 2.0 * u).cos(),
-                0.0,
-            );
+            p.translations[0] =
+                Vec3::new(x, 0.9 + 0.03 * (std::f32::consts::TAU * 2.0 * u).cos(), 0.0);
             p
         })
         .collect();
@@ -232,4 +230,44 @@ fn a_synthetic_loop_wraps_without_snapping_back() {
     let p = &slow.placements[0];
     let path = root_path(&slow, p.start_frame, p.end_frame);
     assert!((path[path.len() - 1].x - path[0].x - 1.0).abs() < 0.05);
+}
+
+#[test]
+fn with_a_motion_graph_the_graph_effort_picks_the_variant() {
+    use figurine_host::anim::graph_cuts::GraphGuide;
+    use figurine_host::anim::variants::choose_variant;
+    use figurine_host::graph::effort::Effort;
+    use figurine_host::graph::roles::RoleOverrides;
+    use figurine_host::graph::source::load_clips;
+    use figurine_host::graph::{build_graph, BuildParams};
+    if !have_data() {
+        return;
+    }
+    let dir = figurine_host::data::data_dir().join("deepmimic");
+    let files: Vec<PathBuf> = ["kick", "spinkick", "walk", "punch"]
+        .iter()
+        .map(|n| dir.join(format!("humanoid3d_{n}.txt")))
+        .collect();
+    let clips = load_clips(&files, &RoleOverrides::new()).unwrap();
+    let (g, _) = build_graph(&clips, &BuildParams::default()).unwrap();
+    let guide = GraphGuide::new(g);
+    let lib = ClipLibrary::default_library().unwrap();
+    let loaded = lib.load(["kick", "jump"]).unwrap();
+    let kick = &loaded["kick"];
+    let e = |v: f32| Effort { time: v, weight: v };
+    let (strong, cs) = choose_variant(kick, e(0.8), Some(&guide));
+    let (light, cl) = choose_variant(kick, e(-0.8), Some(&guide));
+    let (cs, cl) = (cs.unwrap(), cl.unwrap());
+    eprintln!(
+        "graph: strong → {} {cs:?}; light → {} {cl:?}",
+        strong.variant, light.variant
+    );
+    assert!(cs.by_graph && cl.by_graph);
+    assert_eq!(
+        (strong.variant.as_str(), light.variant.as_str()),
+        ("spinkick", "kick")
+    );
+    // The jump's backflip is not in this graph: its variants fall back to their own features.
+    let (_, cj) = choose_variant(&loaded["jump"], e(0.8), Some(&guide));
+    assert!(!cj.unwrap().by_graph);
 }

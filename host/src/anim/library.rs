@@ -100,7 +100,10 @@ impl ActionSpec {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| self.file.clone());
-        let stem = stem.strip_prefix("humanoid3d_").unwrap_or(&stem).to_string();
+        let stem = stem
+            .strip_prefix("humanoid3d_")
+            .unwrap_or(&stem)
+            .to_string();
         match self.frames {
             Some([a, b]) => format!("{stem}[{a}-{b}]"),
             None => stem,
@@ -175,8 +178,7 @@ fn check_variants(variants: &[ActionSpec]) -> Result<(), String> {
     }
     if variants.iter().any(|v| v.moving != variants[0].moving) {
         return Err(
-            "variants disagree on \"moving\": all clips of one action must travel, or none"
-                .into(),
+            "variants disagree on \"moving\": all clips of one action must travel, or none".into(),
         );
     }
     Ok(())
@@ -405,12 +407,10 @@ impl ClipLibrary {
                     .collect();
                 match &names {
                     None => names = Some(joint_names),
-                    Some(n) if *n != joint_names => {
-                        return Err(AnimError::Data(format!(
-                            "{}: clip for {action} ({}) has a different skeleton from the other clips",
-                            self.origin, spec.file
-                        )))
-                    }
+                    Some(n) if *n != joint_names => return Err(AnimError::Data(format!(
+                        "{}: clip for {action} ({}) has a different skeleton from the other clips",
+                        self.origin, spec.file
+                    ))),
                     Some(_) => {}
                 }
                 loaded.push(ac);
@@ -465,17 +465,15 @@ impl ClipLibrary {
             (c, dm.looping)
         };
         clip.name = action.to_string();
-        let source_start_s = (!spec.pingpong)
-            .then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
+        let source_start_s =
+            (!spec.pingpong).then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
         let source_span_s = match spec.frames {
             Some([a, b]) => (a as f32 * clip.frame_time, b as f32 * clip.frame_time),
             None => (0.0, clip.duration()),
         };
         select_frames(&mut clip, spec, &self.origin, action)?;
         let whole = spec.frames.is_none() && !spec.pingpong;
-        let looping = spec
-            .looping
-            .unwrap_or(spec.cyclic || (whole && file_loops));
+        let looping = spec.looping.unwrap_or(spec.cyclic || (whole && file_loops));
         Ok(ActionClip {
             action: action.to_string(),
             variant: spec.variant_name(),
@@ -590,8 +588,14 @@ mod tests {
             (format!("[{clip}, {clip}]"), "two variants are named \"a\""),
             (format!("[{clip}, {moving}]"), "disagree on \"moving\""),
             (format!("[{clip}, 3]"), "expected struct ActionSpec"),
-            (format!("[{clip}, {{\"file\": \"x.bvh\"}}]"), "missing field `moving`"),
-            ("\"walk.bvh\"".to_string(), "a clip object or a list of clip objects"),
+            (
+                format!("[{clip}, {{\"file\": \"x.bvh\"}}]"),
+                "missing field `moving`",
+            ),
+            (
+                "\"walk.bvh\"".to_string(),
+                "a clip object or a list of clip objects",
+            ),
             (format!("[{many}]"), "at most 16 clips"),
         ];
         for (entry, want) in cases {
@@ -628,10 +632,12 @@ mod tests {
         assert_eq!(pick(-0.8, -0.8), "kick");
         // Stable: a second load decides the same.
         let again = lib.load(["kick"]).unwrap();
-        let (v, c) =
-            super::super::variants::choose_variant(&again["kick"], e(0.8, 0.8), None);
+        let (v, c) = super::super::variants::choose_variant(&again["kick"], e(0.8, 0.8), None);
         assert_eq!(v.variant, "spinkick");
-        assert_eq!(c.unwrap().variant_effort, kick.alternatives[0].effort.unwrap());
+        assert_eq!(
+            c.unwrap().variant_effort,
+            kick.alternatives[0].effort.unwrap()
+        );
     }
 
     #[test]

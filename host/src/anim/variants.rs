@@ -233,12 +233,36 @@ mod tests {
         for (side, x) in [("Left", 1.0f32), ("Right", -1.0)] {
             let n = joints.len();
             joints.extend([
-                j(&format!("{side}Arm"), Some(1), Vec3::new(0.0, 0.25, 0.18 * x)),
-                j(&format!("{side}ForeArm"), Some(n), Vec3::new(0.0, -0.28, 0.0)),
-                j(&format!("{side}Hand"), Some(n + 1), Vec3::new(0.0, -0.25, 0.0)),
-                j(&format!("{side}UpLeg"), Some(0), Vec3::new(0.0, -0.05, 0.1 * x)),
-                j(&format!("{side}Leg"), Some(n + 3), Vec3::new(0.0, -0.42, 0.0)),
-                j(&format!("{side}Foot"), Some(n + 4), Vec3::new(0.0, -0.42, 0.0)),
+                j(
+                    &format!("{side}Arm"),
+                    Some(1),
+                    Vec3::new(0.0, 0.25, 0.18 * x),
+                ),
+                j(
+                    &format!("{side}ForeArm"),
+                    Some(n),
+                    Vec3::new(0.0, -0.28, 0.0),
+                ),
+                j(
+                    &format!("{side}Hand"),
+                    Some(n + 1),
+                    Vec3::new(0.0, -0.25, 0.0),
+                ),
+                j(
+                    &format!("{side}UpLeg"),
+                    Some(0),
+                    Vec3::new(0.0, -0.05, 0.1 * x),
+                ),
+                j(
+                    &format!("{side}Leg"),
+                    Some(n + 3),
+                    Vec3::new(0.0, -0.42, 0.0),
+                ),
+                j(
+                    &format!("{side}Foot"),
+                    Some(n + 4),
+                    Vec3::new(0.0, -0.42, 0.0),
+                ),
             ]);
         }
         Skeleton { joints }
@@ -327,7 +351,10 @@ mod tests {
         assert_eq!(b.variant, "calm");
         let (ca, cb) = (ca.unwrap(), cb.unwrap());
         assert!(!ca.by_graph && ca.of == 3 && ca.index == 2);
-        assert!(ca.effort_match > 0.5 && cb.effort_match > 0.5, "{ca:?} {cb:?}");
+        assert!(
+            ca.effort_match > 0.5 && cb.effort_match > 0.5,
+            "{ca:?} {cb:?}"
+        );
         // Deterministic: the same answer every time, and from a fresh load.
         let again = punch_with_variants();
         for _ in 0..3 {
