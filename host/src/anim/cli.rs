@@ -104,7 +104,7 @@ pub enum ClipCommand {
     /// Print the motion stages (§6.1) of a clip: an action of the clip library, a .bvh file or
     /// a DeepMimic motion file.
     Stages {
-        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        /// Action name (`ACTION:VARIANT` for a variant), .bvh file or DeepMimic .txt/.json file.
         clip: String,
         /// Clip library to look action names up in (default: built-in).
         #[arg(long)]
@@ -116,7 +116,7 @@ pub enum ClipCommand {
     /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
     /// to a PNG.
     Plot {
-        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        /// Action name (`ACTION:VARIANT` for a variant), .bvh file or DeepMimic .txt/.json file.
         clip: String,
         /// Output PNG.
         #[arg(long)]
@@ -322,13 +322,34 @@ pub fn load_named_clip(
                 Some(c) => ClipLibrary::read_path(c)?,
                 None => ClipLibrary::default_library()?,
             };
-            let mut loaded = lib.load([name]).with_context(|| {
+            // `ACTION` is the action's primary clip, `ACTION:VARIANT` one of its variants.
+            let (action, variant) = match name.split_once(':') {
+                Some((a, v)) => (a, Some(v)),
+                None => (name, None),
+            };
+            let mut loaded = lib.load([action]).with_context(|| {
                 format!(
                     "{name} is neither a clip file nor an action of {}",
                     lib.origin
                 )
             })?;
-            let ac = loaded.remove(name).context("action vanished")?;
+            let ac = loaded.remove(action).context("action vanished")?;
+            let ac = match variant {
+                None => ac,
+                Some(v) => {
+                    let names: Vec<String> = ac.variants().map(|c| c.variant.clone()).collect();
+                    ac.variants()
+                        .find(|c| c.variant == v)
+                        .cloned()
+                        .with_context(|| {
+                            format!(
+                                "action {action} of {} has no variant {v:?} (it has: {})",
+                                lib.origin,
+                                names.join(", ")
+                            )
+                        })?
+                }
+            };
             Ok((ac.clip, ac.cyclic))
         }
     }

@@ -407,10 +407,12 @@ impl ClipLibrary {
                     .collect();
                 match &names {
                     None => names = Some(joint_names),
-                    Some(n) if *n != joint_names => return Err(AnimError::Data(format!(
+                    Some(n) if *n != joint_names => {
+                        return Err(AnimError::Data(format!(
                         "{}: clip for {action} ({}) has a different skeleton from the other clips",
                         self.origin, spec.file
-                    ))),
+                    )))
+                    }
                     Some(_) => {}
                 }
                 loaded.push(ac);
