@@ -271,3 +271,48 @@ fn with_a_motion_graph_the_graph_effort_picks_the_variant() {
     let (_, cj) = choose_variant(&loaded["jump"], e(0.8), Some(&guide));
     assert!(!cj.unwrap().by_graph);
 }
+
+/// The shipped LAFAN1 walk library: three real gait cycles of different vigour.
+#[test]
+fn lafan_walk_variants_follow_vigour_and_loop_seamlessly() {
+    if figurine_host::data::data_file("bvh", "lafan_test.bvh").is_none() {
+        eprintln!("skipping: bvh/lafan_test.bvh missing — run `cargo xtask setup`");
+        return;
+    }
+    let lib = ClipLibrary::read_path(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/lafan_clips.json"
+    )))
+    .unwrap();
+    let walk = &lib.load(["walk"]).unwrap()["walk"];
+    let speed = |c: &ActionClip| {
+        let r = c.clip.root_path();
+        let d = r[r.len() - 1] - r[0];
+        Vec2::new(d.x, d.z).length() / c.clip.duration()
+    };
+    let mut by_speed: Vec<&ActionClip> = walk.variants().collect();
+    by_speed.sort_by(|a, b| speed(a).total_cmp(&speed(b)));
+    let order: Vec<&str> = by_speed.iter().map(|c| c.variant.as_str()).collect();
+    assert_eq!(order, ["stroll", "walk", "stride"]);
+    // The LMA Weight estimate rises with the walk's speed.
+    let w: Vec<f32> = by_speed.iter().map(|c| c.effort.unwrap().weight).collect();
+    assert!(w[0] < w[1] && w[1] < w[2], "weights {w:?}");
+    let events = [
+        event("walk", 0.0, 4.0, -0.8, -0.8),
+        event("walk", 4.5, 8.5, 0.8, 0.8),
+    ];
+    let asm = run(&lib, &events);
+    let names: Vec<&str> = asm
+        .placements
+        .iter()
+        .map(|p| p.variant.as_ref().unwrap().name.as_str())
+        .collect();
+    assert_eq!(names, ["stroll", "stride"]);
+    for p in &asm.placements {
+        assert!(p.cycles >= 2);
+        let path = root_path(&asm, p.start_frame, p.end_frame);
+        let dir = (path[path.len() - 1] - path[0]).normalize();
+        let (back, longest) = steps(&path, dir);
+        assert!(back < 0.01 && longest < 0.15, "{back} {longest}");
+    }
+}

@@ -14,7 +14,8 @@
 //! repeat whole cycles along the path. `frames` picks an inclusive frame range, `pingpong`
 //! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
 //! `scale` turns a BVH clip's unit into metres (default
-//! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces in its clips.
+//! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces, in its root
+//! joint's frame.
 //!
 //! **Variants.** An action may instead list several clips, e.g. a plain kick and a spinning
 //! kick: `"kick": [ {"name": "kick", "file": …}, {"name": "spinkick", "file": …} ]`. Each
@@ -33,7 +34,9 @@
 //! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
 //! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
 //! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
-//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips.
+//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips, with variants
+//! for kick, jump and wave; `host/assets/lafan_clips.json` maps walk onto three LAFAN1 gait
+//! cycles of different vigour.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -203,7 +206,7 @@ pub struct ClipLibrary {
     /// Skeleton source for DeepMimic clips.
     #[serde(default)]
     pub skeleton: Option<SkeletonSpec>,
-    /// Direction the rig faces in its clips (rig space, horizontal).
+    /// Direction the rig faces, in its root joint's frame (see [`ClipLibrary::forward`]).
     #[serde(default = "default_forward")]
     pub forward: [f32; 3],
     /// Action name → its clip variants.
@@ -293,11 +296,12 @@ impl ClipLibrary {
         Ok(lib)
     }
 
-    /// Facing direction of the rig (unit, horizontal).
+    /// Facing direction of the rig in its root joint's frame (unit): the root's rotation
+    /// carries it to the world facing. DeepMimic's root frame is upright (+X); rigs whose root
+    /// frame is not (LAFAN's hips have +X up, +Z left) face along another axis (+Y).
     pub fn forward(&self) -> Vec3 {
         let f = Vec3::from(self.forward);
-        let f = Vec3::new(f.x, 0.0, f.z);
-        if f.length() > 1e-6 {
+        if f.is_finite() && f.length() > 1e-6 {
             f.normalize()
         } else {
             Vec3::X
@@ -383,6 +387,8 @@ impl ClipLibrary {
         let urdf = self.skeleton_urdf()?;
         let mut out = BTreeMap::new();
         let mut names: Option<Vec<String>> = None;
+        // Variants often cut several ranges from one long take: read each file once.
+        let mut files: BTreeMap<PathBuf, (Clip, bool)> = BTreeMap::new();
         for action in wanted {
             if out.contains_key(action) {
                 continue;
@@ -397,7 +403,7 @@ impl ClipLibrary {
             })?;
             let mut loaded = Vec::with_capacity(entry.variants.len());
             for spec in &entry.variants {
-                let ac = self.load_variant(action, spec, urdf.as_ref())?;
+                let ac = self.load_variant(action, spec, urdf.as_ref(), &mut files)?;
                 let joint_names: Vec<String> = ac
                     .clip
                     .skeleton
@@ -434,38 +440,54 @@ impl ClipLibrary {
         Ok(out)
     }
 
+    /// Reads a clip file as stored (its own length unit) and whether it says it loops.
+    fn read_clip(
+        &self,
+        path: &Path,
+        spec: &ActionSpec,
+        urdf: Option<&(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>,
+    ) -> Result<(Clip, bool), AnimError> {
+        if is_bvh_path(path) {
+            return Ok((read_bvh_path(path)?.clip, false));
+        }
+        let (sk, u) = urdf.ok_or_else(|| {
+            AnimError::Data(format!(
+                "{}: DeepMimic clip {} needs a \"skeleton\" entry",
+                self.origin, spec.file
+            ))
+        })?;
+        let text = std::fs::read_to_string(path).map_err(|e| AnimError::Io {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        let dm = read_deepmimic(&text, path, sk, u)?;
+        Ok((dm.clip, dm.looping))
+    }
+
     /// Loads one variant's clip.
     fn load_variant(
         &self,
         action: &str,
         spec: &ActionSpec,
         urdf: Option<&(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>,
+        files: &mut BTreeMap<PathBuf, (Clip, bool)>,
     ) -> Result<ActionClip, AnimError> {
         let path = self.resolve(&spec.file)?;
-        let is_bvh = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-        let (mut clip, file_loops) = if is_bvh {
-            let mut c = read_bvh_path(&path)?.clip;
-            c.scale_lengths(spec.scale.unwrap_or(0.01));
-            (c, false)
-        } else {
-            let (sk, u) = urdf.ok_or_else(|| {
-                AnimError::Data(format!(
-                    "{}: DeepMimic clip {} needs a \"skeleton\" entry",
-                    self.origin, spec.file
-                ))
-            })?;
-            let text = std::fs::read_to_string(&path).map_err(|e| AnimError::Io {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
-            let dm = read_deepmimic(&text, &path, sk, u)?;
-            let mut c = dm.clip;
-            c.scale_lengths(spec.scale.unwrap_or(1.0));
-            (c, dm.looping)
+        if !files.contains_key(&path) {
+            let read = self.read_clip(&path, spec, urdf)?;
+            files.insert(path.clone(), read);
+        }
+        let Some((clip, file_loops)) = files.get(&path) else {
+            return Err(AnimError::Data(format!(
+                "{}: lost {}",
+                self.origin, spec.file
+            )));
         };
+        let (mut clip, file_loops) = (clip.clone(), *file_loops);
+        let scale = spec
+            .scale
+            .unwrap_or(if is_bvh_path(&path) { 0.01 } else { 1.0 });
+        clip.scale_lengths(scale);
         clip.name = action.to_string();
         let source_start_s =
             (!spec.pingpong).then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
@@ -491,6 +513,12 @@ impl ClipLibrary {
             alternatives: Vec::new(),
         })
     }
+}
+
+fn is_bvh_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
 }
 
 fn select_frames(
