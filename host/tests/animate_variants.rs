@@ -8,7 +8,7 @@ use figurine_host::anim::assemble::{assemble, AssembleOptions, Assembly};
 use figurine_host::anim::library::{ActionClip, ClipLibrary};
 use figurine_host::events::ActionRecord;
 use figurine_host::motion::{Clip, Joint, Pose, Skeleton};
-use glam::{Vec2, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
 fn have_data() -> bool {
     if figurine_host::data::data_file("deepmimic", "humanoid.urdf").is_none() {
@@ -47,6 +47,21 @@ fn root_path(asm: &Assembly, a: usize, b: usize) -> Vec<Vec2> {
         .iter()
         .map(|p| Vec2::new(p.translations[0].x, p.translations[0].z))
         .collect()
+}
+
+/// Largest change of any non-root joint's local rotation between consecutive frames
+/// `a..=b`, degrees.
+fn joint_steps(asm: &Assembly, a: usize, b: usize) -> f32 {
+    asm.clip.frames[a..=b]
+        .windows(2)
+        .flat_map(|w| {
+            w[0].rotations
+                .iter()
+                .zip(&w[1].rotations)
+                .skip(1)
+                .map(|(p, q)| p.angle_between(*q).to_degrees())
+        })
+        .fold(0.0, f32::max)
 }
 
 /// Largest backwards step along `dir` and largest step length between consecutive frames, m.
@@ -105,6 +120,16 @@ fn a_long_walk_wraps_its_cycle_forward() {
     let (back, longest) = steps(&path, Vec2::X);
     assert!(back < 1e-3, "root steps back {back} m along the walk");
     assert!(longest < 0.1, "root jumps {longest} m in one frame");
+    // DeepMimic's walk cycle does not close (its last pose is 28° from its first at the right
+    // shoulder; unclosed, the wrap turns it 28.8° in one frame): closed over the cycle, the
+    // wraps turn no joint more than the clip's own stepping does (knees: up to 17° a frame).
+    let n = p.end_frame - p.start_frame;
+    for k in 1..p.cycles {
+        let seam = p.start_frame + (k * n + p.cycles / 2) / p.cycles;
+        let pop = joint_steps(&asm, seam - 2, seam + 2);
+        eprintln!("walk: wrap {k} at frame {seam}: largest joint step {pop:.1}°");
+        assert!(pop < 18.0, "wrap {k}: a joint turns {pop}° in one frame");
+    }
     let travel = path[path.len() - 1].x - path[0].x;
     assert!(
         travel > 1.0 * p.cycles as f32,
@@ -170,6 +195,8 @@ fn synthetic_loop(frames: usize) -> ActionClip {
             let x = u + 0.1 * (std::f32::consts::TAU * u).sin();
             p.translations[0] =
                 Vec3::new(x, 0.9 + 0.03 * (std::f32::consts::TAU * 2.0 * u).cos(), 0.0);
+            // A loop that does not close: the spine ends 20° away from where it starts.
+            p.rotations[1] = Quat::from_rotation_z(0.35 * u);
             p
         })
         .collect();
@@ -215,6 +242,9 @@ fn a_synthetic_loop_wraps_without_snapping_back() {
     assert!(longest < 0.1, "root jumps {longest} m in one frame");
     let travel = path[path.len() - 1].x - path[0].x;
     assert!((travel - 4.0).abs() < 0.05, "4 cycles of 1 m: {travel} m");
+    // The spine's 20° mismatch is spread over each cycle: no pop at the wraps.
+    let pop = joint_steps(&asm, p.start_frame, p.end_frame);
+    assert!(pop < 2.0, "a joint turns {pop}° in one frame");
     // Without the loop the same event plays the clip once, slowly.
     let mut once = synthetic_loop(31);
     once.looping = false;

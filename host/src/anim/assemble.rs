@@ -590,6 +590,11 @@ fn place_action(
         off += rot2(turn, loop_step);
         turn = (loop_turn * turn).normalize();
     }
+    let closure = if cycles > 1 {
+        loop_closure(clip)
+    } else {
+        Vec::new()
+    };
     let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
     let mut sigma_max = 0.0f32;
     let mut poses = Vec::with_capacity(n + 1);
@@ -606,6 +611,7 @@ fn place_action(
         let src_t = ec.source_time(w);
         src_times.push(src_t);
         let mut pose = ec.clip.sample(src_t);
+        close_loop(&mut pose, &closure, src_t / clip.duration().max(1e-6));
         let r = pose.translations[0];
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
@@ -682,6 +688,42 @@ fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32
         (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
     } else {
         1
+    }
+}
+
+/// Per joint (the root's entry unused): the local rotation taking the clip's last pose onto its
+/// first, `first · last⁻¹`. Mocap loops rarely close exactly (DeepMimic's walk ends 28° away
+/// from its start at the right shoulder); spread over the cycle by [`close_loop`], the cycle's
+/// end meets the next cycle's start without a pop.
+fn loop_closure(clip: &Clip) -> Vec<Quat> {
+    let (Some(first), Some(last)) = (clip.frames.first(), clip.frames.last()) else {
+        return Vec::new();
+    };
+    first
+        .rotations
+        .iter()
+        .zip(&last.rotations)
+        .map(|(a, b)| {
+            let d = (*a * b.inverse()).normalize();
+            if d.w < 0.0 {
+                -d
+            } else {
+                d
+            }
+        })
+        .collect()
+}
+
+/// Applies the fraction `u` ∈ [0, 1] of the cycle (source time / clip duration) of the loop
+/// closure to a pose's non-root joints (the root's turn is the cycle's own, kept).
+fn close_loop(pose: &mut Pose, closure: &[Quat], u: f32) {
+    let u = if u.is_finite() {
+        u.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    for (r, d) in pose.rotations.iter_mut().zip(closure).skip(1) {
+        *r = (Quat::IDENTITY.slerp(*d, u) * *r).normalize();
     }
 }
 
