@@ -102,6 +102,21 @@ fn sudden_strong_and_sustained_light_kicks_play_different_variants() {
     let light = asm.placements[1].variant.as_ref().unwrap();
     assert!(strong.variant_effort.time > 0.0 && strong.variant_effort.weight > 0.0);
     assert!(light.variant_effort.time < 0.0 && light.variant_effort.weight < 0.0);
+    // The variant carries most of the effort; only the rest is transferred onto it.
+    for (p, want) in asm.placements.iter().zip([0.8f32, -0.8]) {
+        let v = p.variant.as_ref().unwrap();
+        let a = p.applied_effort;
+        assert!(
+            (a.time - (want - v.variant_effort.time)).abs() < 1e-6,
+            "{a:?}"
+        );
+        assert!(
+            a.time.abs() < want.abs() && a.weight.abs() < want.abs(),
+            "{a:?}"
+        );
+    }
+    // A single-clip action gets the whole recognised effort.
+    assert_eq!(asm.placements[2].applied_effort.time, 0.8);
     // Deterministic: the same events give the same animation, bit for bit.
     let again = run(&lib, &events);
     assert_eq!(asm.clip.frames, again.clip.frames);

@@ -91,6 +91,9 @@ pub struct Placement {
     pub stages: Vec<(Stage, f32, f32)>,
     /// The clip variant played and why (`None` when the action has a single clip).
     pub variant: Option<VariantChoice>,
+    /// The effort transferred onto the clip (§6.3–6.4): the recognised one, less what the
+    /// chosen variant already carries (see [`residual_effort`]).
+    pub applied_effort: Effort,
 }
 
 /// The assembled animation and what was done to make it.
@@ -275,7 +278,8 @@ pub fn assemble_guided(
                 }
             })
             .clone();
-        let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
+        let applied = residual_effort(effort, variant.as_ref());
+        let ec = apply_effort(&ac.clip, &phrasing, applied, forward, ac.cyclic);
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
@@ -322,6 +326,7 @@ pub fn assemble_guided(
             cycles,
             stages,
             variant,
+            applied_effort: applied,
         });
         placed.push(Placed {
             f0,
@@ -458,6 +463,23 @@ pub fn assemble_guided(
         graph_cuts,
         t_origin: t_shift,
     })
+}
+
+/// The effort to transfer onto a chosen variant: the recognised effort less the variant's own
+/// (both in [−1, 1], the difference clamped). A variant's effort is measured relative to its
+/// siblings, so a sudden-strong kick played by the spinning kick, which is sudden and strong
+/// already, is not retimed and amplified a second time; a single clip (no choice) gets the
+/// whole recognised effort, as in seed 000 §6.
+pub fn residual_effort(recognised: Effort, variant: Option<&VariantChoice>) -> Effort {
+    let e = recognised.sanitized();
+    match variant {
+        Some(v) => Effort {
+            time: e.time - v.variant_effort.time,
+            weight: e.weight - v.variant_effort.weight,
+        }
+        .sanitized(),
+        None => e,
+    }
 }
 
 /// Stretches a cut (i, j) to at least `min_blend` frames, half before and half after, staying

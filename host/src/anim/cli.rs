@@ -260,14 +260,16 @@ fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
             .as_ref()
             .map(|v| {
                 format!(
-                    "  variant {} ({}/{}, effort Lt {:+.2} Lw {:+.2} by {}, match {:.2})",
+                    "  variant {} ({}/{}, its effort Lt {:+.2} Lw {:+.2} by {}, match {:.2}; transferred Lt {:+.2} Lw {:+.2})",
                     v.name,
                     v.index + 1,
                     v.of,
                     v.variant_effort.time,
                     v.variant_effort.weight,
                     if v.by_graph { "graph" } else { "clip" },
-                    v.effort_match
+                    v.effort_match,
+                    p.applied_effort.time,
+                    p.applied_effort.weight
                 )
             })
             .unwrap_or_default();
