@@ -361,3 +361,41 @@ fn lafan_walk_variants_follow_vigour_and_loop_seamlessly() {
         assert!(back < 0.01 && longest < 0.15, "{back} {longest}");
     }
 }
+
+#[test]
+fn clip_variants_lists_what_each_effort_plays() {
+    if !have_data() {
+        return;
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_figurine"))
+        .args(["clip", "variants"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("sudden-strong → spinkick") && text.contains("sustained-light → kick"),
+        "{text}"
+    );
+    // A malformed variant list: the error names the file and line.
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("animate_variants");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("empty_variants.json");
+    std::fs::write(&bad, "{ \"version\": 1,\n\"actions\": { \"kick\": [] } }").unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_figurine"))
+        .args(["clip", "variants", "--clips"])
+        .arg(&bad)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("empty_variants.json:2:") && err.contains("empty variant list"),
+        "{err}"
+    );
+}

@@ -113,6 +113,17 @@ pub enum ClipCommand {
         #[arg(long)]
         urdf: Option<PathBuf>,
     },
+    /// List every action's clip variants with their Laban effort estimates (from their
+    /// Effort-component LMA features, or from a motion graph), and which one each of the four
+    /// effort corners would play.
+    Variants {
+        /// Clip library (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// Motion graph whose effort estimates to use where it holds the variants' clips.
+        #[arg(long)]
+        graph: Option<PathBuf>,
+    },
     /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
     /// to a PNG.
     Plot {
@@ -389,6 +400,9 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        ClipCommand::Variants { clips, graph } => {
+            print_variants(clips.as_deref(), graph.as_deref())
+        }
         ClipCommand::Plot {
             clip,
             out,
@@ -417,4 +431,57 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
             Ok(())
         }
     }
+}
+
+/// Prints `figurine clip variants`.
+fn print_variants(clips: Option<&Path>, graph: Option<&Path>) -> anyhow::Result<()> {
+    use crate::graph::effort::Effort;
+    let lib = match clips {
+        Some(c) => ClipLibrary::read_path(c)?,
+        None => ClipLibrary::default_library()?,
+    };
+    let guide = graph.map(GraphGuide::load).transpose()?;
+    let names: Vec<String> = lib.actions.keys().cloned().collect();
+    let loaded = lib.load(names.iter().map(String::as_str))?;
+    let corners = [
+        ("sudden-strong", 0.8, 0.8),
+        ("sudden-light", 0.8, -0.8),
+        ("sustained-strong", -0.8, 0.8),
+        ("sustained-light", -0.8, -0.8),
+    ];
+    println!("{}: {} actions", lib.origin, loaded.len());
+    for (action, ac) in &loaded {
+        if ac.alternatives.is_empty() {
+            println!("  {action:10} {} (single clip)", ac.variant);
+            continue;
+        }
+        println!("  {action:10} {} variants", 1 + ac.alternatives.len());
+        for v in ac.variants() {
+            let e = v.effort.unwrap_or_default();
+            println!(
+                "    {:12} {:6.2} s  effort from its own LMA features: Lt {:+.2} Lw {:+.2}",
+                v.variant,
+                v.clip.duration(),
+                e.time,
+                e.weight
+            );
+        }
+        let picks: Vec<String> = corners
+            .iter()
+            .map(|(name, t, w)| {
+                let want = Effort {
+                    time: *t,
+                    weight: *w,
+                };
+                let (v, c) = super::variants::choose_variant(ac, want, guide.as_ref());
+                let by = match c {
+                    Some(c) if c.by_graph => " (graph)",
+                    _ => "",
+                };
+                format!("{name} → {}{by}", v.variant)
+            })
+            .collect();
+        println!("    plays: {}", picks.join(", "));
+    }
+    Ok(())
 }
