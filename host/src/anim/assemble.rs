@@ -1,7 +1,9 @@
 //! The assembler: recognised actions + doodle → one character animation (seed 000 §6).
 //!
-//! For each event (in time order) the action's clip gets its efforts (retime, rescale,
-//! reshape), is stretched over the event's `[start, end]` (output frame f shows log time
+//! For each event (in time order) the action's clip variant matching the recognised effort is
+//! chosen ([`super::variants`]), gets the rest of the effort the variant does not already
+//! carry (retime, rescale, reshape; [`residual_effort`]), is stretched over the event's
+//! `[start, end]` (output frame f shows log time
 //! `t_origin + f / fps`, so timing matches the events), and is placed in the world:
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
@@ -12,6 +14,13 @@
 //!   not travel (anticipation, landing, follow-through) and moves along the path, in step
 //!   with the clip's own travel, during the execution (stage boundaries from phrasing can
 //!   fall inside the take-off, so the clip's travel, not the label, decides).
+//!
+//! - **looping in place**: a looping clip (DeepMimic `"Loop": "wrap"`, or `cyclic`) that plays
+//!   in place repeats as many whole times as fill the event; each repetition starts where the
+//!   previous one ended (the clip's own per-cycle ground displacement and turn carried on, so
+//!   the root never snaps back), and each cycle's joint mismatch between its last and first
+//!   pose is spread over the cycle so the wraps do not pop (this loop closure applies to
+//!   cyclic walks along the path too).
 //!
 //! Actions start at their event's start; an event shorter than its clip allows at
 //! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
