@@ -38,6 +38,7 @@ use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix
 use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
+use super::looping::{close_loop, cycle_frames, loop_closure};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
@@ -599,28 +600,7 @@ fn place_action(
     } else {
         0.0
     };
-    // Looping in place: cycle k starts where cycle k − 1 ended, i.e. cycle k is the clip
-    // turned by k × the clip's own yaw per cycle and shifted by the sum of the earlier cycles'
-    // ground displacements (zero for anchored clips), so the root never snaps back.
-    let loop_turn = Quat::from_rotation_y(if cycles > 1 {
-        let a = ground(q0 * forward).normalize_or(Vec2::X);
-        let b = ground(ql * forward).normalize_or(Vec2::X);
-        super::trajectory::yaw(b) - super::trajectory::yaw(a)
-    } else {
-        0.0
-    });
-    let loop_step = if ac.anchor {
-        Vec2::ZERO
-    } else {
-        ground(rl - r0)
-    };
-    let mut loop_frames: Vec<(Vec2, Quat)> = Vec::with_capacity(cycles.max(1));
-    let (mut off, mut turn) = (Vec2::ZERO, Quat::IDENTITY);
-    for _ in 0..cycles.max(1) {
-        loop_frames.push((off, turn));
-        off += rot2(turn, loop_step);
-        turn = (loop_turn * turn).normalize();
-    }
+    let loop_frames = cycle_frames(clip, forward, ac.anchor, cycles);
     let closure = if cycles > 1 {
         loop_closure(clip)
     } else {
@@ -719,42 +699,6 @@ fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32
         (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
     } else {
         1
-    }
-}
-
-/// Per joint (the root's entry unused): the local rotation taking the clip's last pose onto its
-/// first, `first · last⁻¹`. Mocap loops rarely close exactly (DeepMimic's walk ends 28° away
-/// from its start at the right shoulder); spread over the cycle by [`close_loop`], the cycle's
-/// end meets the next cycle's start without a pop.
-fn loop_closure(clip: &Clip) -> Vec<Quat> {
-    let (Some(first), Some(last)) = (clip.frames.first(), clip.frames.last()) else {
-        return Vec::new();
-    };
-    first
-        .rotations
-        .iter()
-        .zip(&last.rotations)
-        .map(|(a, b)| {
-            let d = (*a * b.inverse()).normalize();
-            if d.w < 0.0 {
-                -d
-            } else {
-                d
-            }
-        })
-        .collect()
-}
-
-/// Applies the fraction `u` ∈ [0, 1] of the cycle (source time / clip duration) of the loop
-/// closure to a pose's non-root joints (the root's turn is the cycle's own, kept).
-fn close_loop(pose: &mut Pose, closure: &[Quat], u: f32) {
-    let u = if u.is_finite() {
-        u.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    for (r, d) in pose.rotations.iter_mut().zip(closure).skip(1) {
-        *r = (Quat::IDENTITY.slerp(*d, u) * *r).normalize();
     }
 }
 
