@@ -317,11 +317,14 @@ fn with_a_motion_graph_the_graph_effort_picks_the_variant() {
     assert!(!cj.unwrap().by_graph);
 }
 
-/// The shipped LAFAN1 walk library: three real gait cycles of different vigour.
+/// The shipped LAFAN1 library: three real gait cycles and three dance stretches of different
+/// vigour.
 #[test]
 fn lafan_walk_variants_follow_vigour_and_loop_seamlessly() {
-    if figurine_host::data::data_file("bvh", "lafan_test.bvh").is_none() {
-        eprintln!("skipping: bvh/lafan_test.bvh missing — run `cargo xtask setup`");
+    if figurine_host::data::data_file("bvh", "lafan_test.bvh").is_none()
+        || figurine_host::data::data_file("bvh", "lafan_dance1.bvh").is_none()
+    {
+        eprintln!("skipping: LAFAN1 BVH files missing — run `cargo xtask setup`");
         return;
     }
     let lib = ClipLibrary::read_path(Path::new(concat!(
@@ -353,6 +356,16 @@ fn lafan_walk_variants_follow_vigour_and_loop_seamlessly() {
         .map(|p| p.variant.as_ref().unwrap().name.as_str())
         .collect();
     assert_eq!(names, ["stroll", "stride"]);
+    // The dance stretches standing in for a wave: the calmest and the wildest.
+    let wave = &lib.load(["wave"]).unwrap()["wave"];
+    let pick = |v: f32| {
+        let e = figurine_host::graph::effort::Effort { time: v, weight: v };
+        figurine_host::anim::variants::choose_variant(wave, e, None)
+            .0
+            .variant
+            .clone()
+    };
+    assert_eq!((pick(0.8), pick(-0.8)), ("wild".into(), "sway".into()));
     for p in &asm.placements {
         assert!(p.cycles >= 2);
         let path = root_path(&asm, p.start_frame, p.end_frame);
