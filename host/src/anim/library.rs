@@ -36,7 +36,7 @@
 //! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
 //! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips, with variants
 //! for kick, jump and wave; `host/assets/lafan_clips.json` maps walk onto three LAFAN1 gait
-//! cycles of different vigour.
+//! cycles and wave onto three dance stretches, each of different vigour.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
