@@ -8,7 +8,7 @@
 //! labelled `c`, level k is updated as
 //! ```text
 //! D'[0] = T(D[0] ∪ {0}) ∩ B[c]
-//! D'[k] = T(D[k] ∪ {0}) ∩ B[c]     match
+//! D'[k] = T(D[k] ∪ Iₖ) ∩ B[c]      match (Iₖ: the start and the positions k deletions from it)
 //!       ∪ D[k−1]                    insertion (extra token)
 //!       ∪ T(D[k−1] ∪ {0})           substitution
 //!       ∪ T(D'[k−1] ∪ {0})          deletion (pattern position skipped)
@@ -49,9 +49,15 @@ fn step_pattern(p: &Pattern<'_>, d: &mut [u64; LEVELS], c: Token) -> Option<u8> 
     let mut best = None;
     let mut prev_old = 0u64;
     let mut prev_new = 0u64;
+    // Where a match may begin at level k: the start, or up to k leading pattern positions
+    // skipped (each skip one edit).
+    let mut init = 1u64;
     for (k, slot) in d.iter_mut().enumerate().take(k_max + 1) {
+        if k > 0 {
+            init |= p.forward(init) & !1;
+        }
         let old = *slot;
-        let mut new = p.forward(old | 1) & b;
+        let mut new = p.forward(old | init) & b;
         if k > 0 {
             new |= prev_old | p.forward(prev_old | 1) | p.forward(prev_new | 1);
         }
@@ -95,6 +101,20 @@ impl MatcherBank {
     }
 }
 
+/// Whether `tokens`, read from their first, are an exact prefix of a match of `p` that has
+/// not ended (some position of the pattern is live and it is not only the accepting one): the
+/// gesture of `p` is under way and may go on. One forward step per token.
+pub fn prefix_alive(p: &Pattern<'_>, tokens: impl IntoIterator<Item = Token>) -> bool {
+    let mut d = 1u64;
+    for t in tokens {
+        d = p.forward(d) & p.symbol_mask(t) & !1;
+        if d == 0 {
+            return false;
+        }
+    }
+    d & !p.last() != 0
+}
+
 /// Runs pattern `p` backwards over the tokens ending a match: `token_back(0)` is the last
 /// token of the match, `token_back(j)` the one `j` tokens earlier (`None` past the available
 /// history). Returns `(j, k)`: the largest `j` such that tokens `j..=0` match `p` with
@@ -136,11 +156,22 @@ pub fn earliest_start(
             new &= !1 & !END;
             *slot = new;
             live |= new != 0;
-            if new & first != 0 {
-                // Keep the lowest distance; among equal distances the longest (latest j).
-                match found {
-                    Some((_, fk)) if fk < k as u8 => {}
-                    _ => found = Some((j, k as u8)),
+            // A match may start here, at a first position of the pattern, or after leading
+            // positions that were skipped (each skip one more edit, as the forward automaton
+            // allows).
+            let mut reach = new;
+            for kk in k..=k_max {
+                if reach & first != 0 {
+                    // Keep the lowest distance; among equal distances the longest (latest j).
+                    match found {
+                        Some((_, fk)) if fk < kk as u8 => {}
+                        _ => found = Some((j, kk as u8)),
+                    }
+                    break;
+                }
+                reach = rev(reach) & !1 & !END;
+                if reach == 0 {
+                    break;
                 }
             }
             prev_old = old;
@@ -200,6 +231,34 @@ mod tests {
         assert_eq!(run(&blob, "u d b")[2][0], 1);
         // Two edits exceed the bound.
         assert_eq!(run(&blob, "u r r b")[3][0], 255);
+    }
+
+    #[test]
+    fn the_first_parts_of_a_pattern_may_be_missing() {
+        // A punch without its wind-up: `f b` is `b f b` with the leading `b` deleted.
+        let blob = seq_library(&[(&["b", "f", "b"], 1), (&["u", "f", "d", "b"], 2)]);
+        assert_eq!(run(&blob, "f b")[1][0], 1);
+        // Two leading parts missing: two edits.
+        assert_eq!(run(&blob, "d b")[1][1], 2);
+        assert_eq!(run(&blob, "b")[0][1], 255);
+        // The reverse search agrees on where such a match starts and what it costs.
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        let stream = toks("f b");
+        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
+        assert_eq!(earliest_start(&p, 1, back), Some((1, 1)));
+        assert_eq!(earliest_start(&p, 0, back), None);
+    }
+
+    #[test]
+    fn a_live_prefix_is_a_gesture_under_way() {
+        let blob = seq_library(&[(&["b", "f", "b"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        assert!(prefix_alive(&p, toks("b f")));
+        assert!(!prefix_alive(&p, toks("f b")));
+        // Complete: nothing left to wait for.
+        assert!(!prefix_alive(&p, toks("b f b")));
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Stage 8 — Laban effort: two Gaussian naive Bayes classifiers (seed 000 §5.4).
 //!
 //! One classifier per axis: Time (positive class *sudden*) and Weight (positive class
-//! *strong*), each over its own subset of the 50 segment features, chosen on the host by the
+//! *strong*), each over its own subset of the 54 segment features, chosen on the host by the
 //! inter/intra-class variance ratio and cross-validation. The output is continuous:
 //! `L = tanh(Λ / (2·m))`, where Λ is the log posterior odds of the positive class and m the
 //! number of features used — the posterior difference `2P − 1` with the evidence tempered per

@@ -1,31 +1,44 @@
 //! Stage 7 — Laban features (seed 000 §5.2), accumulated in constant memory.
 //!
-//! Per tick, 25 quantities: the magnitudes of the 6 object-frame components' velocity,
-//! acceleration and jerk (18: |vx| |vy| |vz| |ωx| |ωy| |ωz|, then the same for acceleration and
-//! jerk), and 7 world quantities: speed, |acceleration|, |jerk|, curvature, |torsion|, equi-affine
-//! velocity `|det(ṙ, r̈, r⃛)|^(1/6)` and the magnitude of its time derivative (equi-affine
-//! acceleration). Curvature and torsion are clamped to ±[`GEOM_CLAMP`] where speed vanishes.
+//! Per tick, 27 quantities. The seed's 25: the magnitudes of the 6 object-frame components'
+//! velocity, acceleration and jerk (18: |vx| |vy| |vz| |ωx| |ωy| |ωz|, then the same for
+//! acceleration and jerk), and 7 world quantities: speed, |acceleration|, |jerk|, curvature,
+//! |torsion|, equi-affine velocity `|det(ṙ, r̈, r⃛)|^(1/6)` and the magnitude of its time
+//! derivative (equi-affine acceleration). Curvature and torsion are clamped to ±[`GEOM_CLAMP`]
+//! where speed vanishes. Two of ours split the tangential acceleration `ṙ·r̈/|ṙ|` into its
+//! speeding-up and slowing-down parts: how a stroke *starts* (an explosive or an easing onset:
+//! Time) and how it *stops* (an impact or a fade: Weight) are what Laban observers look at,
+//! and the seed's unsigned magnitudes mix the two.
 //!
 //! [`Accum`] keeps count, Σx and Σx² per quantity (one per token run: any segment's statistics
 //! are the sum of its runs' accumulators). [`segment_features`] turns an accumulator into the
-//! 50 features — mean then standard deviation of each quantity — in the log domain
-//! `ln(FEATURE_EPS + x)`, where Gaussian naive Bayes fits much better than on the raw,
-//! heavy-tailed, scale-multiplicative values.
+//! 54 features — the mean of each quantity, then its *relative* spread (standard deviation
+//! over mean, the coefficient of variation) — in the log domain `ln(FEATURE_EPS + x)`, where
+//! Gaussian naive Bayes fits much better than on the raw, heavy-tailed values. Means carry the
+//! tempo (they are rates per second once divided by the mean speed); the relative spread is
+//! free of both size and duration and carries the shape of the effort: accelerations
+//! concentrated in a short impact spread far more than evenly eased ones. The seed's plain
+//! standard deviation is, in the log domain, the sum of the two and adds nothing a naive
+//! Bayes classifier could use that they do not — but it confounds tempo and shape.
 
 use crate::fmath;
 use crate::frame::Kinematics;
 use crate::intake::TICK_S;
 
 /// Per-tick quantities.
-pub const QUANTITIES: usize = 25;
-/// Segment features: mean and std of each quantity.
+pub const QUANTITIES: usize = 27;
+/// Segment features: mean and relative spread of each quantity.
 pub const FEATURES: usize = 2 * QUANTITIES;
 /// Bound on |curvature| (1/m) and |torsion| (1/m).
 pub const GEOM_CLAMP: f32 = 1000.0;
 /// Offset inside the log transform of features.
 pub const FEATURE_EPS: f32 = 1e-4;
+/// Floor of a quantity's mean when dividing its standard deviation by it (a quantity that
+/// stayed 0 throughout then has relative spread 0, not NaN).
+pub const MEAN_FLOOR: f32 = 1e-6;
 
-/// Short names of the 25 quantities, in order (features `i` and `25 + i` are their mean and std).
+/// Short names of the quantities, in order (features `i` and `QUANTITIES + i` are their mean
+/// and relative spread).
 pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
     "vel.left",
     "vel.up",
@@ -52,9 +65,11 @@ pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
     "torsion",
     "equiaffine.vel",
     "equiaffine.acc",
+    "world.speedup",
+    "world.slowdown",
 ];
 
-/// Sums over a set of ticks. 204 bytes.
+/// Sums over a set of ticks. 220 bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accum {
     /// Number of ticks.
@@ -107,10 +122,11 @@ impl Accum {
 /// the features do not change when the same gesture is made larger or smaller. The mean world
 /// speed itself (feature 18) stays absolute: the one feature that knows the size.
 const SCALE_KIND: [u8; QUANTITIES] = [
-    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3,
+    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3, 1, 1,
 ];
 
-/// The 50 log-domain, scale-free features of a segment (see [`SCALE_KIND`]).
+/// The log-domain, scale-free features of a segment: means (see [`SCALE_KIND`]), then
+/// coefficients of variation.
 pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
     let mut out = [fmath::ln(FEATURE_EPS); FEATURES];
     if a.n == 0 {
@@ -122,15 +138,17 @@ pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
     for i in 0..QUANTITIES {
         let mean = a.sum[i] / n;
         let var = fmath::max(a.sum_sq[i] / n - mean * mean, 0.0);
+        // The mean world speed itself stays absolute: the one feature that knows the size.
         let k = match SCALE_KIND[i] {
+            _ if i == 18 => 1.0,
             1 => 1.0 / speed,
             2 => path,
             3 => 1.0 / fmath::sqrt(path),
             _ => 1.0,
         };
-        let k_mean = if i == 18 { 1.0 } else { k };
-        out[i] = fmath::ln(FEATURE_EPS + fmath::max(mean, 0.0) * k_mean);
-        out[QUANTITIES + i] = fmath::ln(FEATURE_EPS + fmath::sqrt(var) * k);
+        out[i] = fmath::ln(FEATURE_EPS + fmath::max(mean, 0.0) * k);
+        out[QUANTITIES + i] =
+            fmath::ln(FEATURE_EPS + fmath::sqrt(var) / fmath::max(mean, MEAN_FLOOR));
     }
     out
 }
@@ -156,7 +174,7 @@ impl FeatureExtractor {
         self.prev_va = None;
     }
 
-    /// The 25 quantities of one tick (all finite and ≥ 0).
+    /// The quantities of one tick (all finite and ≥ 0).
     pub fn quantities(&mut self, k: &Kinematics) -> [f32; QUANTITIES] {
         let mut q = [0.0f32; QUANTITIES];
         let groups = [k.v, k.w, k.a, k.wa, k.j, k.wj];
@@ -192,6 +210,14 @@ impl FeatureExtractor {
         q[22] = fmath::clamp(fmath::abs(torsion), 0.0, GEOM_CLAMP);
         q[23] = eq_v;
         q[24] = eq_a;
+        // Along the path: > 0 speeding up, < 0 slowing down.
+        let tangential = if speed > 1e-4 {
+            fmath::dot3(v, a) / speed
+        } else {
+            0.0
+        };
+        q[25] = fmath::max(tangential, 0.0);
+        q[26] = fmath::max(-tangential, 0.0);
         for x in &mut q {
             if !fmath::is_finite(*x) {
                 *x = 0.0;
@@ -249,6 +275,40 @@ mod tests {
     }
 
     #[test]
+    fn tangential_acceleration_splits_into_speeding_up_and_slowing_down() {
+        let mut fx = FeatureExtractor::new();
+        // Moving along +x at 1 m/s, accelerating 3 m/s² forwards and 4 m/s² sideways.
+        let q = fx.quantities(&kin([1.0, 0.0, 0.0], [3.0, 4.0, 0.0], [0.0; 3]));
+        assert!((q[25] - 3.0).abs() < 1e-5 && q[26] == 0.0, "{q:?}");
+        let q = fx.quantities(&kin([1.0, 0.0, 0.0], [-2.0, 4.0, 0.0], [0.0; 3]));
+        assert!(q[25] == 0.0 && (q[26] - 2.0).abs() < 1e-5, "{q:?}");
+        // At rest there is no path to be along.
+        let q = fx.quantities(&kin([0.0; 3], [5.0, 0.0, 0.0], [0.0; 3]));
+        assert!(q[25] == 0.0 && q[26] == 0.0);
+    }
+
+    #[test]
+    fn an_impact_spreads_its_slowing_down_more_than_a_fade() {
+        // Same stroke, same total slowing down (1 m/s over the segment): once over 2 ticks
+        // (an impact) or evenly over 20 (a fade).
+        let seg = |ticks: usize| {
+            let mut a = Accum::new();
+            let mut q = [0.0; QUANTITIES];
+            q[18] = 1.0;
+            for i in 0..20 {
+                q[26] = if i < ticks {
+                    1.0 / (ticks as f32 * TICK_S)
+                } else {
+                    0.0
+                };
+                a.add(&q);
+            }
+            segment_features(&a)[QUANTITIES + 26]
+        };
+        assert!(seg(2) > seg(20) + 1.0, "{} vs {}", seg(2), seg(20));
+    }
+
+    #[test]
     fn accumulated_mean_and_std() {
         let mut a = Accum::new();
         let mut q = [0.0; QUANTITIES];
@@ -257,9 +317,11 @@ mod tests {
             a.add(&q);
         }
         let f = segment_features(&a);
-        // Relative to the (floored) mean speed of 1e-3 m/s.
+        // Mean relative to the (floored) mean speed of 1e-3 m/s; spread relative to the mean.
         assert!((f[0] - libm::logf(FEATURE_EPS + 2.0e3)).abs() < 1e-4);
-        assert!((f[QUANTITIES] - libm::logf(FEATURE_EPS + 1.0e3)).abs() < 1e-4);
+        assert!((f[QUANTITIES] - libm::logf(FEATURE_EPS + 0.5)).abs() < 1e-4);
+        // A quantity that never moved: spread 0, not NaN.
+        assert_eq!(f[QUANTITIES + 1], libm::logf(FEATURE_EPS));
         assert_eq!(segment_features(&Accum::new())[3], libm::logf(FEATURE_EPS));
     }
 }

@@ -10,7 +10,7 @@
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
 //! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision) →
-//! [`features`] (50 Laban features) → [`bayes`] (naive Bayes Time/Weight). [`frontend`] and
+//! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (naive Bayes Time/Weight). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
 //!
 //! # Capacities and RAM (with 32 actions loaded)
@@ -19,7 +19,7 @@
 //! | [`pattern::MAX_ACTIONS`] | 32 actions | 64 B of record offsets (patterns stay in flash) |
 //! | [`pattern::MAX_POSITIONS`] | 32 tokens per pattern | blob ≤ [`pattern::MAX_LIBRARY_BYTES`] (flash) |
 //! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 4 × 8 B = 1 KiB of automaton state |
-//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.1 KiB (features per run) |
+//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.7 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
 //!

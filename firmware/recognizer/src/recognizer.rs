@@ -6,7 +6,7 @@
 //! effort model 0.6 KiB, a held cyclic event 0.2 KiB — 12.4 KiB in all (`size_of`, measured by
 //! a test) with 32 actions loaded.
 
-use crate::automaton::{earliest_start, MatcherBank, Matches};
+use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
 use crate::frontend::{FrontEvent, Frontend};
@@ -14,7 +14,8 @@ use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    Candidate, Decider, Decision, CYCLIC_PAUSE_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS,
+    Candidate, Decider, Decision, CYCLIC_PAUSE_US, HOLD_BACK_TOKENS, HOLD_US, LONG_PAUSE_US,
+    LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -87,6 +88,8 @@ pub struct Recognizer<'lib> {
     now_us: u64,
     now_seq: u32,
     held: Option<Held>,
+    /// The STILL run last checked for a longer action in progress, and the answer.
+    hold: Option<(u32, bool)>,
 }
 
 impl<'lib> Recognizer<'lib> {
@@ -104,6 +107,7 @@ impl<'lib> Recognizer<'lib> {
             now_us: 0,
             now_seq: 0,
             held: None,
+            hold: None,
         }
     }
 
@@ -171,7 +175,20 @@ impl<'lib> Recognizer<'lib> {
         if let Some(r) = newest.and_then(|i| hist.get(i)) {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
-                if let Decision::Commit(c) = self.decider.stillness(still) {
+                let longer = match (self.decider.pending(), newest) {
+                    (Some(p), Some(run)) if (PAUSE_US..HOLD_US).contains(&still) => {
+                        match self.hold {
+                            Some((r, v)) if r == run => v,
+                            _ => {
+                                let v = self.longer_in_progress(&p);
+                                self.hold = Some((run, v));
+                                v
+                            }
+                        }
+                    }
+                    _ => false,
+                };
+                if let Decision::Commit(c) = self.decider.stillness(still, longer) {
                     self.commit(c, &mut emit);
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
@@ -187,6 +204,48 @@ impl<'lib> Recognizer<'lib> {
                 self.release(&mut emit);
             }
         }
+    }
+
+    /// Whether another action's exact match began up to [`HOLD_BACK_TOKENS`] tokens before
+    /// `p` (so it covers `p` and more) and is still under way: then a pause after `p` is a hold
+    /// inside that longer gesture — a punch held at full reach after its forward stroke.
+    fn longer_in_progress(&self, p: &Candidate) -> bool {
+        let hist = self.front.history();
+        let Some(newest) = hist.newest() else {
+            return false;
+        };
+        let moving = |i: u32| hist.get(i).filter(|r| r.token != STILL).map(|r| r.token);
+        // Runs from `from` to the newest, in order (STILL skipped).
+        let tokens_from = move |from: u32| {
+            (0..=newest.wrapping_sub(from)).filter_map(move |k| moving(from.wrapping_add(k)))
+        };
+        let mut start = p.start;
+        for _ in 0..HOLD_BACK_TOKENS {
+            // The previous moving run before `start`, not below the floor.
+            let mut i = start;
+            let prev = loop {
+                if i == self.floor {
+                    break None;
+                }
+                i = i.wrapping_sub(1);
+                if moving(i).is_some() {
+                    break Some(i);
+                }
+            };
+            let Some(s) = prev else { return false };
+            start = s;
+            for a in 0..self.library.len() {
+                if a == usize::from(p.action) {
+                    continue;
+                }
+                if let Some(pat) = self.library.pattern(a) {
+                    if prefix_alive(&pat, tokens_from(start)) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
     }
 
     fn release(&mut self, emit: &mut impl FnMut(ActionEvent)) {
@@ -353,6 +412,11 @@ impl<'lib> Recognizer<'lib> {
         let (Some(start), Some(end)) = (start, end) else {
             return;
         };
+        if end.1.saturating_sub(start.1) < MIN_ACTION_US {
+            // A flicker of a token or two that happens to spell a short pattern: no child's
+            // gesture is this brief. Its runs are consumed; nothing is emitted.
+            return;
+        }
         match &mut self.held {
             Some(h) if h.action == c.action && contiguous => {
                 h.end = end;

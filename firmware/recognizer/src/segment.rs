@@ -8,7 +8,8 @@
 //! - a candidate appears that starts after it (the next action has begun),
 //! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
 //! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
-//!   whose pattern repeats as a whole), or
+//!   whose pattern repeats as a whole; up to [`HOLD_US`] while another action has matched
+//!   further than it exactly and may go on after the hold), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
@@ -21,6 +22,13 @@ pub const PAUSE_US: u64 = 120_000;
 /// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
 /// pauses briefly between hops without ending.
 pub const CYCLIC_PAUSE_US: u64 = 260_000;
+/// Stillness inside a longer action that does not yet commit a shorter pending one, µs: a
+/// punch held at full reach, a crouch held low.
+pub const HOLD_US: u64 = 500_000;
+/// Shortest action that is emitted, µs (first run's start to last run's end).
+pub const MIN_ACTION_US: u64 = 150_000;
+/// Moving runs before a pending candidate where a longer action in progress may have begun.
+pub const HOLD_BACK_TOKENS: usize = 2;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
 pub const LONG_PAUSE_US: u64 = 2_500_000;
 
@@ -121,13 +129,18 @@ impl Decider {
         }
     }
 
-    /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`].
-    pub fn stillness(&mut self, still_us: u64) -> Decision {
-        match self.pending {
-            Some(p) if still_us >= if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US } => {
-                Decision::Commit(p)
-            }
-            _ => Decision::Wait,
+    /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`] —
+    /// or after [`HOLD_US`] while `longer_in_progress` (a longer action has matched further
+    /// than the pending one and may go on after the hold).
+    pub fn stillness(&mut self, still_us: u64, longer_in_progress: bool) -> Decision {
+        let Some(p) = self.pending else {
+            return Decision::Wait;
+        };
+        let pause = if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US };
+        if still_us >= pause && (still_us >= HOLD_US || !longer_in_progress) {
+            Decision::Commit(p)
+        } else {
+            Decision::Wait
         }
     }
 }
@@ -173,8 +186,19 @@ mod tests {
         );
         let mut d = Decider::new();
         d.offer(Some(c(0, 2, 3, 0)), 0);
-        assert_eq!(d.stillness(PAUSE_US - 1), Decision::Wait);
-        assert_eq!(d.stillness(PAUSE_US), Decision::Commit(c(0, 2, 3, 0)));
-        assert_eq!(Decider::new().stillness(10 * PAUSE_US), Decision::Wait);
+        assert_eq!(d.stillness(PAUSE_US - 1, false), Decision::Wait);
+        assert_eq!(
+            d.stillness(PAUSE_US, false),
+            Decision::Commit(c(0, 2, 3, 0))
+        );
+        assert_eq!(
+            Decider::new().stillness(10 * PAUSE_US, false),
+            Decision::Wait
+        );
+        // A longer action in progress: the pause is a hold inside it.
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 2, 3, 0)), 0);
+        assert_eq!(d.stillness(PAUSE_US, true), Decision::Wait);
+        assert_eq!(d.stillness(HOLD_US, true), Decision::Commit(c(0, 2, 3, 0)));
     }
 }

@@ -1,7 +1,7 @@
 //! `figurine train-effort`: Laban Time/Weight classifiers from labelled one-gesture logs.
 //!
 //! DIR holds `sudden-strong/`, `sudden-light/`, `sustained-strong/`, `sustained-light/` with
-//! one-gesture pose logs. Each log's 50 features are computed by the device front end over the
+//! one-gesture pose logs. Each log's 54 features are computed by the device front end over the
 //! gesture (first to last motion). Per axis, features are ranked by σ²inter / σ²intra
 //! (seed 000 §5.3, eqs. 2–5); the number M of top features is chosen by stratified k-fold
 //! cross-validated accuracy of the Gaussian naive Bayes classifier (§5.4; ranking redone

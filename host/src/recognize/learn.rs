@@ -22,7 +22,7 @@ use clap::Args;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::token::{
-    mirror_token, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
+    mirror_token, symbol_matches, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
 };
 use figurine_recognizer::Library;
 
@@ -124,6 +124,19 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
         .collect()
 }
 
+/// The symbol meaning both `a` and `b` when one is a wildcard covering the other (`d~` for
+/// `d` and `d~`), else `None`.
+pub fn common_symbol(a: Symbol, b: Symbol) -> Option<Symbol> {
+    let flags = ANY_LIN | ANY_ROT;
+    if a == b || (a & flags != 0 && b & flags == 0 && symbol_matches(a, b)) {
+        Some(a)
+    } else if b & flags != 0 && a & flags == 0 && symbol_matches(b, a) {
+        Some(b)
+    } else {
+        None
+    }
+}
+
 /// Token string as the automata see it (STILL already removed).
 pub fn tokens_only(t: &Tokenized) -> Vec<Token> {
     t.iter().map(|x| x.0).collect()
@@ -137,8 +150,16 @@ fn mandatory_flags(t: &Tokenized) -> Vec<bool> {
         .collect()
 }
 
+/// Whether two symbols move the same way (same translation half, not none): `b` then `b.Xp`
+/// is one backward stroke during which a rotation began.
+fn same_translation(a: Symbol, b: Symbol) -> bool {
+    let lin = |s: Symbol| (s & 0x3ff) / 27;
+    lin(a) == lin(b) && lin(a) != NONE_BIN && (a & ANY_LIN) == 0 && (b & ANY_LIN) == 0
+}
+
 /// Mandatory runs (token, index in `t`); a repeat of the previous mandatory token separated
-/// from it only by optional runs is the same gesture part and is merged.
+/// from it only by optional runs is the same gesture part and is merged, and so is a run
+/// right after one with the same translation (the column then accepts both).
 fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
     let flags = mandatory_flags(t);
     let mut mand: Vec<(Token, usize)> = Vec::new();
@@ -148,11 +169,18 @@ fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
         }
         match mand.last() {
             Some(&(prev, at)) if prev == x.0 && at + 1 < i => {}
+            Some(&(prev, at)) if at + 1 == i && same_translation(prev, x.0) => {}
             _ => mand.push((x.0, i)),
         }
     }
     mand
 }
+
+/// Mandatory columns a learnt pattern keeps at least (when its reference has that many).
+pub const MIN_MANDATORY: usize = 1;
+
+/// Distinct tokens sharing one half that make the other half a wildcard.
+pub const WILDCARD_VARIANTS: usize = 3;
 
 /// Replaces tokens that differ only in one half by a wildcard symbol (`uf~`, `~.Yp`) when at
 /// least two of them share the other half: the examples disagree there, so it is not part of
@@ -168,11 +196,15 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         }
         let (lin, ang) = (t / 27, t % 27);
         let plain = |u: &&Token| **u & (ANY_LIN | ANY_ROT) == 0;
-        if lin != NONE_BIN && set.iter().filter(plain).filter(|&&u| u / 27 == lin).count() >= 2 {
+        if lin != NONE_BIN
+            && set.iter().filter(plain).filter(|&&u| u / 27 == lin).count() >= WILDCARD_VARIANTS
+        {
             out.insert((lin * 27 + NONE_BIN) | ANY_ROT);
             covered.insert(t);
         }
-        if ang != NONE_BIN && set.iter().filter(plain).filter(|&&u| u % 27 == ang).count() >= 2 {
+        if ang != NONE_BIN
+            && set.iter().filter(plain).filter(|&&u| u % 27 == ang).count() >= WILDCARD_VARIANTS
+        {
             out.insert((NONE_BIN * 27 + ang) | ANY_LIN);
             covered.insert(t);
         }
@@ -198,30 +230,48 @@ enum Op {
     Ins(usize),
 }
 
-/// Edit-distance alignment of `b` to reference `a`.
+/// Alignment cost of leaving a token unpaired (an optional or missing gesture part).
+const INDEL: usize = 2;
+
+/// Alignment cost of pairing two symbols in one column: 0 when they mean the same motion,
+/// 1 when they share their translation (the examples disagree only about a rotation), and
+/// more than two unpaired tokens otherwise — a column never joins unrelated motions such as
+/// `d` and `u`, which would make `(d|u)+` accept either.
+fn pair_cost(a: Symbol, b: Symbol) -> usize {
+    let half = |s: Symbol| (s & 0x3ff) / 27;
+    if common_symbol(a, b).is_some() {
+        0
+    } else if half(a) == half(b) && half(a) != NONE_BIN {
+        1
+    } else {
+        2 * INDEL + 1
+    }
+}
+
+/// Alignment of `b` to reference `a` (costs: [`pair_cost`], [`INDEL`]).
 fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
     let (n, m) = (a.len(), b.len());
     let mut d = vec![vec![0usize; m + 1]; n + 1];
     for (i, row) in d.iter_mut().enumerate() {
-        row[0] = i;
+        row[0] = i * INDEL;
     }
     for (j, v) in d[0].iter_mut().enumerate() {
-        *v = j;
+        *v = j * INDEL;
     }
     for i in 1..=n {
         for j in 1..=m {
-            let sub = d[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
-            d[i][j] = sub.min(d[i - 1][j] + 1).min(d[i][j - 1] + 1);
+            let sub = d[i - 1][j - 1] + pair_cost(a[i - 1], b[j - 1]);
+            d[i][j] = sub.min(d[i - 1][j] + INDEL).min(d[i][j - 1] + INDEL);
         }
     }
     let (mut i, mut j) = (n, m);
     let mut ops = Vec::new();
     while i > 0 || j > 0 {
-        if i > 0 && j > 0 && d[i][j] == d[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]) {
+        if i > 0 && j > 0 && d[i][j] == d[i - 1][j - 1] + pair_cost(a[i - 1], b[j - 1]) {
             ops.push(Op::Pair(i - 1, j - 1));
             i -= 1;
             j -= 1;
-        } else if i > 0 && d[i][j] == d[i - 1][j] + 1 {
+        } else if i > 0 && d[i][j] == d[i - 1][j] + INDEL {
             ops.push(Op::Del(i - 1));
             i -= 1;
         } else {
@@ -303,10 +353,17 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         for (j, &(_, idx)) in mand.iter().enumerate() {
             is_col[idx] = col_of[j];
         }
-        // Runs merged into a mandatory duplicate count as that column.
+        // Runs merged into a mandatory duplicate or same-translation neighbour count as that
+        // column, which accepts them too.
         for i in 1..s.len() {
-            if is_col[i].is_none() && flags[i] && s[i].0 == s[i - 1].0 {
+            if is_col[i].is_none()
+                && flags[i]
+                && (s[i].0 == s[i - 1].0 || same_translation(s[i].0, s[i - 1].0))
+            {
                 is_col[i] = is_col[i - 1];
+                if let Some(c) = is_col[i] {
+                    cols[c].insert(s[i].0);
+                }
             }
         }
         let mut next_col = vec![n; s.len() + 1];
@@ -341,6 +398,18 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             opt_support.push(per_seq.iter().filter(|v| !v.is_empty()).count());
         }
     }
+    // A column is optional when most sequences lack it — but a pattern keeps at least
+    // [`MIN_MANDATORY`] mandatory column (the best supported): one made only of optional
+    // parts matches any lone token of its alphabet.
+    let mut optional_col: Vec<bool> = missing.iter().map(|&m| 2 * m >= seqs.len()).collect();
+    let mut by_support: Vec<usize> = (0..n).collect();
+    by_support.sort_by_key(|&g| (missing[g], g));
+    for &g in by_support.iter().take(MIN_MANDATORY.min(n)) {
+        if optional_col.iter().filter(|o| !**o).count() >= MIN_MANDATORY.min(n) {
+            break;
+        }
+        optional_col[g] = false;
+    }
     loop {
         let mut items = Vec::new();
         for g in 0..=n {
@@ -356,7 +425,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                 ));
                 // Optional only when most sequences lack it: a part one performance skipped
                 // is still part of the gesture (that performance then costs an edit).
-                items.push(if 2 * missing[g] >= seqs.len() {
+                items.push(if optional_col[g] {
                     Regex::Star(Box::new(alt))
                 } else {
                     Regex::Plus(Box::new(alt))
@@ -653,17 +722,48 @@ mod tests {
 
     #[test]
     fn tokens_disagreeing_in_one_half_become_wildcards() {
-        let set: BTreeSet<Token> = ["uf.Zp", "uf.Zn", "f", ".Yn", "d.Yn"]
-            .iter()
-            .map(|t| parse_token(t).unwrap())
-            .collect();
-        let names: Vec<String> = generalise(&set)
-            .into_iter()
-            .map(super::super::regex::symbol_name)
-            .collect();
-        assert_eq!(names.len(), 3, "{names:?}");
-        assert!(names.contains(&"uf~".to_string()) && names.contains(&"~.Yn".to_string()));
-        assert!(names.contains(&"f".to_string()));
+        let names = |tokens: &[&str]| -> Vec<String> {
+            let set: BTreeSet<Token> = tokens.iter().map(|t| parse_token(t).unwrap()).collect();
+            generalise(&set)
+                .into_iter()
+                .map(super::super::regex::symbol_name)
+                .collect()
+        };
+        let n = names(&["uf.Zp", "uf.Zn", "uf.Xp", "f", ".Yn", "d.Yn", "u.Yn"]);
+        assert_eq!(n.len(), 3, "{n:?}");
+        assert!(n.contains(&"uf~".to_string()) && n.contains(&"~.Yn".to_string()));
+        assert!(n.contains(&"f".to_string()));
+        // Two variants are not evidence enough: a kick's `b.Xp` must not become any `b~`
+        // (a punch's `b.Zn`).
+        let n = names(&["b", "b.Xp"]);
+        assert_eq!(n, ["b", "b.Xp"], "{n:?}");
+    }
+
+    #[test]
+    fn a_stroke_whose_rotation_begins_midway_is_one_column() {
+        // `b b.Xp` (one backward stroke, the rotation starting halfway) aligns with `b.Xp`.
+        let re = learn_regex(&[
+            seq("f.Xn:0.3 b.Xp:0.3"),
+            seq("f.Xn:0.3 b:0.15 b.Xp:0.15"),
+            seq("f.Xn:0.3 b.Xp:0.3"),
+        ])
+        .unwrap();
+        let src = re.to_source();
+        assert_eq!(src.matches('+').count(), 2, "{src}");
+        assert!(src.contains("b.Xp") && src.contains("(b|b.Xp)"), "{src}");
+    }
+
+    #[test]
+    fn a_pattern_keeps_one_mandatory_column() {
+        // No column is shared by most examples; the best supported stays mandatory.
+        let re = learn_regex(&[
+            seq("f:0.3 uf:0.3"),
+            seq("df:0.3 ub:0.3"),
+            seq("df:0.3 ub:0.3"),
+            seq("f:0.3 uf:0.3"),
+        ])
+        .unwrap();
+        assert!(re.to_source().contains('+'), "{}", re.to_source());
     }
 
     #[test]

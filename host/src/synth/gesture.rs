@@ -148,10 +148,17 @@ impl Draw<'_> {
         self.rng.uniform(lo_deg, hi_deg).to_radians()
     }
 
+    /// A dimension of the toy itself (metres): the figurine does not grow when the child
+    /// plays bigger, so neither the doodle's scale nor the effort's amplitude applies.
+    fn body(&mut self, lo: f64, hi: f64) -> f64 {
+        self.rng.uniform(lo, hi)
+    }
+
     /// Where the fingers hold the toy when twisting it about the vertical: a horizontal offset
-    /// of 0–3 cm (× scale), so turns and spins also swing the tracked point a little.
+    /// of 0–3 cm from the tracked centre (a toy dimension), so turns and spins also swing the
+    /// tracked point a little.
     fn grip(&mut self) -> DVec3 {
-        let r = self.rng.uniform(0.0, 0.03) * self.scale;
+        let r = self.body(0.0, 0.03);
         let a = self.rng.uniform(0.0, std::f64::consts::TAU);
         DVec3::new(r * a.cos(), 0.0, r * a.sin())
     }
@@ -352,7 +359,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
         }
         Action::Bow => {
             // The toy pivots about its feet, `r` below the tracked centre.
-            let feet = DVec3::new(0.0, -d.len(0.03, 0.07), 0.0);
+            let feet = DVec3::new(0.0, -d.body(0.03, 0.07), 0.0);
             let theta = d.ang(30.0, 70.0);
             let mut down = d.stroke(0.5, 0.8);
             down.rotate.x = theta;
@@ -368,7 +375,7 @@ pub fn plan(action: Action, shape: &EffortShape, scale: f64, rng: &mut SynthRng)
             let amp = d.ang(15.0, 30.0);
             let cycles = d.rng.int(2, 4);
             let first = d.rng.sign();
-            let feet = DVec3::new(0.0, -d.len(0.02, 0.05), 0.0);
+            let feet = DVec3::new(0.0, -d.body(0.02, 0.05), 0.0);
             // Roll targets: +A, −A, +A, … then back to 0, rocking about the feet.
             let mut targets: Vec<f64> = (0..2 * cycles)
                 .map(|k| if k % 2 == 0 { amp } else { -amp } * first)
