@@ -1,7 +1,9 @@
 //! The assembler: recognised actions + doodle → one character animation (seed 000 §6).
 //!
-//! For each event (in time order) the action's clip gets its efforts (retime, rescale,
-//! reshape), is stretched over the event's `[start, end]` (output frame f shows log time
+//! For each event (in time order) the action's clip variant matching the recognised effort is
+//! chosen ([`super::variants`]), gets the rest of the effort the variant does not already
+//! carry (retime, rescale, reshape; [`residual_effort`]), is stretched over the event's
+//! `[start, end]` (output frame f shows log time
 //! `t_origin + f / fps`, so timing matches the events), and is placed in the world:
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
@@ -12,6 +14,13 @@
 //!   not travel (anticipation, landing, follow-through) and moves along the path, in step
 //!   with the clip's own travel, during the execution (stage boundaries from phrasing can
 //!   fall inside the take-off, so the clip's travel, not the label, decides).
+//!
+//! - **looping in place**: a looping clip (DeepMimic `"Loop": "wrap"`, or `cyclic`) that plays
+//!   in place repeats as many whole times as fill the event; each repetition starts where the
+//!   previous one ended (the clip's own per-cycle ground displacement and turn carried on, so
+//!   the root never snaps back), and each cycle's joint mismatch between its last and first
+//!   pose is spread over the cycle so the wraps do not pop (this loop closure applies to
+//!   cyclic walks along the path too).
 //!
 //! Actions start at their event's start; an event shorter than its clip allows at
 //! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
@@ -29,9 +38,11 @@ use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix
 use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
+use super::looping::{close_loop, cycle_frames, loop_closure};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
+use super::variants::{choose_variant, VariantChoice};
 use super::AnimError;
 use crate::events::ActionRecord;
 use crate::motion::{Clip, Pose};
@@ -88,6 +99,11 @@ pub struct Placement {
     pub cycles: usize,
     /// Stages on the log's clock: (stage, start s, end s).
     pub stages: Vec<(Stage, f32, f32)>,
+    /// The clip variant played and why (`None` when the action has a single clip).
+    pub variant: Option<VariantChoice>,
+    /// The effort transferred onto the clip (§6.3–6.4): the recognised one, less what the
+    /// chosen variant already carries (see [`residual_effort`]).
+    pub applied_effort: Effort,
 }
 
 /// The assembled animation and what was done to make it.
@@ -120,8 +136,10 @@ struct Placed {
     src_times: Vec<f32>,
     /// The event's recognised effort.
     effort: Effort,
-    /// The action (key of the clip map).
-    action: String,
+    /// The source clip file of the variant played.
+    file: std::path::PathBuf,
+    /// Seconds of the source file where the played clip starts (see [`ActionClip`]).
+    source_start_s: Option<f32>,
     /// Per frame, per leg: the source clip's foot contact at the frame's source time.
     contacts: Vec<Vec<bool>>,
 }
@@ -239,15 +257,29 @@ pub fn assemble_guided(
     let mut placements: Vec<Placement> = Vec::new();
     let mut last_f1 = 0usize;
     for ev in &evs {
-        let Some(ac) = clips.get(&ev.action) else {
+        let Some(primary) = clips.get(&ev.action) else {
             continue;
         };
+        let effort = Effort {
+            time: ev.time as f32,
+            weight: ev.weight as f32,
+        };
+        let (ac, variant) = choose_variant(
+            primary,
+            crate::graph::effort::Effort {
+                time: effort.time,
+                weight: effort.weight,
+            },
+            guide,
+        );
+        // Caches are per variant.
+        let key = format!("{}\u{0}{}", ev.action, ac.variant);
         let mut f0 = frame_of(ev.start);
         if !placed.is_empty() && f0 < last_f1 {
             f0 = last_f1; // overlapping events: the later one starts when the earlier ends
         }
         let phrasing = phrasings
-            .entry(ev.action.clone())
+            .entry(key.clone())
             .or_insert_with(|| {
                 if ac.cyclic {
                     Phrasing::whole(&ac.clip)
@@ -256,11 +288,8 @@ pub fn assemble_guided(
                 }
             })
             .clone();
-        let effort = Effort {
-            time: ev.time as f32,
-            weight: ev.weight as f32,
-        };
-        let ec = apply_effort(&ac.clip, &phrasing, effort, forward, ac.cyclic);
+        let applied = residual_effort(effort, variant.as_ref());
+        let ec = apply_effort(&ac.clip, &phrasing, applied, forward, ac.cyclic);
         let chunk = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
@@ -275,7 +304,7 @@ pub fn assemble_guided(
         let (poses, world_path, cycles, src_times) =
             place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
         let src_contacts = source_contacts
-            .entry(ev.action.clone())
+            .entry(key)
             .or_insert_with(|| detect_contacts(&ac.clip, &legs))
             .clone();
         let contacts = src_times
@@ -306,6 +335,8 @@ pub fn assemble_guided(
             moving: ac.moving,
             cycles,
             stages,
+            variant,
+            applied_effort: applied,
         });
         placed.push(Placed {
             f0,
@@ -313,7 +344,8 @@ pub fn assemble_guided(
             contacts,
             src_times,
             effort,
-            action: ev.action.clone(),
+            file: ac.file.clone(),
+            source_start_s: ac.source_start_s,
         });
         last_f1 = f1;
     }
@@ -328,20 +360,15 @@ pub fn assemble_guided(
     for w in placed.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         let graph_cut = guide.and_then(|g| {
-            let src = |p: &'_ Placed| {
-                let ac = clips.get(&p.action)?;
-                Some((ac.file.clone(), ac.source_start_s))
-            };
-            let ((fa, sa), (fb, sb)) = (src(a)?, src(b)?);
             let pa = PlacedSource {
-                file: &fa,
-                source_start_s: sa,
+                file: &a.file,
+                source_start_s: a.source_start_s,
                 f0: a.f0,
                 src_times: &a.src_times,
             };
             let pb = PlacedSource {
-                file: &fb,
-                source_start_s: sb,
+                file: &b.file,
+                source_start_s: b.source_start_s,
                 f0: b.f0,
                 src_times: &b.src_times,
             };
@@ -446,6 +473,23 @@ pub fn assemble_guided(
         graph_cuts,
         t_origin: t_shift,
     })
+}
+
+/// The effort to transfer onto a chosen variant: the recognised effort less the variant's own
+/// (both in [−1, 1], the difference clamped). A variant's effort is measured relative to its
+/// siblings, so a sudden-strong kick played by the spinning kick, which is sudden and strong
+/// already, is not retimed and amplified a second time; a single clip (no choice) gets the
+/// whole recognised effort, as in seed 000 §6.
+pub fn residual_effort(recognised: Effort, variant: Option<&VariantChoice>) -> Effort {
+    let e = recognised.sanitized();
+    match variant {
+        Some(v) => Effort {
+            time: e.time - v.variant_effort.time,
+            weight: e.weight - v.variant_effort.weight,
+        }
+        .sanitized(),
+        None => e,
+    }
 }
 
 /// Stretches a cut (i, j) to at least `min_blend` frames, half before and half after, staying
@@ -556,13 +600,19 @@ fn place_action(
     } else {
         0.0
     };
+    let loop_frames = cycle_frames(clip, forward, ac.anchor, cycles);
+    let closure = if cycles > 1 {
+        loop_closure(clip)
+    } else {
+        Vec::new()
+    };
     let exec = ec.stage_w(Stage::Execution).unwrap_or((0.0, 1.0));
     let mut sigma_max = 0.0f32;
     let mut poses = Vec::with_capacity(n + 1);
     let mut src_times = Vec::with_capacity(n + 1);
     for k in 0..=n {
         let u = k as f32 / n.max(1) as f32;
-        let (w, cycle) = if ac.cyclic {
+        let (w, cycle) = if cycles > 1 {
             let uc = u * cycles as f32;
             let c = (uc.floor() as usize).min(cycles - 1);
             (uc - c as f32, c)
@@ -572,15 +622,23 @@ fn place_action(
         let src_t = ec.source_time(w);
         src_times.push(src_t);
         let mut pose = ec.clip.sample(src_t);
+        close_loop(&mut pose, &closure, src_t / clip.duration().max(1e-6));
         let r = pose.translations[0];
         let q = pose.rotations[0];
         let (root_xz, rot) = if !moving {
             let drift = if ac.anchor {
-                ground(rl - r0) * (ec.source_time(w) / clip.duration().max(1e-6))
+                ground(rl - r0) * (src_t / clip.duration().max(1e-6))
             } else {
                 Vec2::ZERO
             };
-            (base + rot2(r_start, ground(r - r0) - drift), r_start)
+            let (off, turn) = loop_frames
+                .get(cycle)
+                .copied()
+                .unwrap_or((Vec2::ZERO, Quat::IDENTITY));
+            (
+                base + rot2(r_start, off + rot2(turn, ground(r - r0) - drift)),
+                r_start * turn,
+            )
         } else if ac.cyclic {
             let s = (cycle as f32 * cycle_len + along(r - r0)) * stretch;
             let tangent = chunk.tangent_at(s, 0.3).unwrap_or(start_heading);
@@ -624,7 +682,9 @@ fn place_action(
 
 /// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
 /// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
-/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put); 1 otherwise.
+/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put). A looping clip that
+/// plays in place (or a cyclic one without a path to follow) repeats as many whole times as
+/// fill the duration at its own speed. 1 otherwise (moving, non-cyclic actions play once).
 fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
     let root = ec.clip.root_path();
     let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
@@ -635,6 +695,8 @@ fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32
         let by_path = (chunk.length() / cycle_len).round() as usize;
         let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
         by_path.min(by_time).max(1)
+    } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {
+        (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
     } else {
         1
     }

@@ -104,7 +104,7 @@ pub enum ClipCommand {
     /// Print the motion stages (§6.1) of a clip: an action of the clip library, a .bvh file or
     /// a DeepMimic motion file.
     Stages {
-        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        /// Action name (`ACTION:VARIANT` for a variant), .bvh file or DeepMimic .txt/.json file.
         clip: String,
         /// Clip library to look action names up in (default: built-in).
         #[arg(long)]
@@ -113,10 +113,21 @@ pub enum ClipCommand {
         #[arg(long)]
         urdf: Option<PathBuf>,
     },
+    /// List every action's clip variants with their Laban effort estimates (from their
+    /// Effort-component LMA features, or from a motion graph), and which one each of the four
+    /// effort corners would play.
+    Variants {
+        /// Clip library (default: built-in).
+        #[arg(long)]
+        clips: Option<PathBuf>,
+        /// Motion graph whose effort estimates to use where it holds the variants' clips.
+        #[arg(long)]
+        graph: Option<PathBuf>,
+    },
     /// Draw a clip's contact sheet (root path from above, twelve stick figures from the side)
     /// to a PNG.
     Plot {
-        /// Action name, .bvh file or DeepMimic .txt/.json file.
+        /// Action name (`ACTION:VARIANT` for a variant), .bvh file or DeepMimic .txt/.json file.
         clip: String,
         /// Output PNG.
         #[arg(long)]
@@ -255,8 +266,26 @@ fn print_summary(asm: &Assembly, out: &Path, glb: Option<&Path>) {
             .iter()
             .map(|(s, a, b)| format!("{s} {a:.2}-{b:.2}"))
             .collect();
+        let variant = p
+            .variant
+            .as_ref()
+            .map(|v| {
+                format!(
+                    "  variant {} ({}/{}, its effort Lt {:+.2} Lw {:+.2} by {}, match {:.2}; transferred Lt {:+.2} Lw {:+.2})",
+                    v.name,
+                    v.index + 1,
+                    v.of,
+                    v.variant_effort.time,
+                    v.variant_effort.weight,
+                    if v.by_graph { "graph" } else { "clip" },
+                    v.effort_match,
+                    p.applied_effort.time,
+                    p.applied_effort.weight
+                )
+            })
+            .unwrap_or_default();
         println!(
-            "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]",
+            "  {:9} {:6.2}-{:6.2} s  {}{}  path {:.2} m  [{}]{variant}",
             p.action,
             asm.t_origin as f32 + p.start_frame as f32 * c.frame_time,
             asm.t_origin as f32 + p.end_frame as f32 * c.frame_time,
@@ -306,13 +335,34 @@ pub fn load_named_clip(
                 Some(c) => ClipLibrary::read_path(c)?,
                 None => ClipLibrary::default_library()?,
             };
-            let mut loaded = lib.load([name]).with_context(|| {
+            // `ACTION` is the action's primary clip, `ACTION:VARIANT` one of its variants.
+            let (action, variant) = match name.split_once(':') {
+                Some((a, v)) => (a, Some(v)),
+                None => (name, None),
+            };
+            let mut loaded = lib.load([action]).with_context(|| {
                 format!(
                     "{name} is neither a clip file nor an action of {}",
                     lib.origin
                 )
             })?;
-            let ac = loaded.remove(name).context("action vanished")?;
+            let ac = loaded.remove(action).context("action vanished")?;
+            let ac = match variant {
+                None => ac,
+                Some(v) => {
+                    let names: Vec<String> = ac.variants().map(|c| c.variant.clone()).collect();
+                    ac.variants()
+                        .find(|c| c.variant == v)
+                        .cloned()
+                        .with_context(|| {
+                            format!(
+                                "action {action} of {} has no variant {v:?} (it has: {})",
+                                lib.origin,
+                                names.join(", ")
+                            )
+                        })?
+                }
+            };
             Ok((ac.clip, ac.cyclic))
         }
     }
@@ -350,6 +400,9 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        ClipCommand::Variants { clips, graph } => {
+            print_variants(clips.as_deref(), graph.as_deref())
+        }
         ClipCommand::Plot {
             clip,
             out,
@@ -378,4 +431,57 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
             Ok(())
         }
     }
+}
+
+/// Prints `figurine clip variants`.
+fn print_variants(clips: Option<&Path>, graph: Option<&Path>) -> anyhow::Result<()> {
+    use crate::graph::effort::Effort;
+    let lib = match clips {
+        Some(c) => ClipLibrary::read_path(c)?,
+        None => ClipLibrary::default_library()?,
+    };
+    let guide = graph.map(GraphGuide::load).transpose()?;
+    let names: Vec<String> = lib.actions.keys().cloned().collect();
+    let loaded = lib.load(names.iter().map(String::as_str))?;
+    let corners = [
+        ("sudden-strong", 0.8, 0.8),
+        ("sudden-light", 0.8, -0.8),
+        ("sustained-strong", -0.8, 0.8),
+        ("sustained-light", -0.8, -0.8),
+    ];
+    println!("{}: {} actions", lib.origin, loaded.len());
+    for (action, ac) in &loaded {
+        if ac.alternatives.is_empty() {
+            println!("  {action:10} {} (single clip)", ac.variant);
+            continue;
+        }
+        println!("  {action:10} {} variants", 1 + ac.alternatives.len());
+        for v in ac.variants() {
+            let e = v.effort.unwrap_or_default();
+            println!(
+                "    {:12} {:6.2} s  effort from its own LMA features: Lt {:+.2} Lw {:+.2}",
+                v.variant,
+                v.clip.duration(),
+                e.time,
+                e.weight
+            );
+        }
+        let picks: Vec<String> = corners
+            .iter()
+            .map(|(name, t, w)| {
+                let want = Effort {
+                    time: *t,
+                    weight: *w,
+                };
+                let (v, c) = super::variants::choose_variant(ac, want, guide.as_ref());
+                let by = match c {
+                    Some(c) if c.by_graph => " (graph)",
+                    _ => "",
+                };
+                format!("{name} → {}{by}", v.variant)
+            })
+            .collect();
+        println!("    plays: {}", picks.join(", "));
+    }
+    Ok(())
 }

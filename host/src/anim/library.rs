@@ -14,11 +14,29 @@
 //! repeat whole cycles along the path. `frames` picks an inclusive frame range, `pingpong`
 //! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
 //! `scale` turns a BVH clip's unit into metres (default
-//! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces in its clips.
+//! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces, in its root
+//! joint's frame.
+//!
+//! **Variants.** An action may instead list several clips, e.g. a plain kick and a spinning
+//! kick: `"kick": [ {"name": "kick", "file": …}, {"name": "spinkick", "file": …} ]`. Each
+//! element is a clip object as above plus an optional `name` (default: the file's stem, with
+//! its frame range). The assembler plays the variant whose Effort-component LMA features best
+//! match the action's recognised Laban Time and Weight (see [`super::variants`]); the first
+//! variant is the action's primary clip (the one shown by `figurine clip`, and the tie winner).
+//! A list must hold 1 to [`MAX_VARIANTS`] clips with distinct names that agree on `moving`;
+//! anything else is an error naming the file and line. A single clip object is a list of one,
+//! so older libraries read unchanged.
+//!
+//! **Loops.** `loop` says whether the clip may be repeated seamlessly when an action lasts
+//! longer than it (the root carried forward by the clip's own per-cycle displacement and
+//! turn). Default: DeepMimic's `"Loop": "wrap"` for a whole DeepMimic file (no `frames`, no
+//! `pingpong`), `cyclic` otherwise. Moving actions that are not cyclic (jumps) play once.
 //! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
 //! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
 //! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
-//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips.
+//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips, with variants
+//! for kick, jump and wave; `host/assets/lafan_clips.json` maps walk onto three LAFAN1 gait
+//! cycles and wave onto three dance stretches, each of different vigour.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,6 +44,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::Deserialize;
 
+use super::clip_spec::check_variants;
+pub use super::clip_spec::{ActionEntry, ActionSpec, MAX_VARIANTS};
 use super::AnimError;
 use crate::motion::deepmimic::{humanoid_skeleton, read_deepmimic};
 use crate::motion::urdf::read_urdf_path;
@@ -33,35 +53,6 @@ use crate::motion::{read_bvh_path, Clip, Skeleton};
 
 /// The built-in default library text.
 pub const DEFAULT_LIBRARY: &str = include_str!("../../assets/default_clips.json");
-
-/// How one action is played.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ActionSpec {
-    /// Clip file: relative to the library, or `KIND/NAME` in the data folder.
-    pub file: String,
-    /// Whether the character travels along the doodle (false: in place, §6.2).
-    pub moving: bool,
-    /// Whether the clip is one cycle of a repeating motion (walk, run).
-    pub cyclic: bool,
-    /// Inclusive frame range of the source clip to use.
-    #[serde(default)]
-    pub frames: Option<[usize; 2]>,
-    /// Play the range backwards, then forwards (e.g. a rise played as down-and-up).
-    #[serde(default)]
-    pub pingpong: bool,
-    /// In-place actions only: remove the clip's net ground drift (linearly over the clip) so
-    /// the character ends where it started, as the seed's in-place rule has it. For clips
-    /// that travel although their action should not (DeepMimic's spin); feet slide a little.
-    #[serde(default)]
-    pub anchor: bool,
-    /// Length unit → metres for BVH clips (default 0.01).
-    #[serde(default)]
-    pub scale: Option<f32>,
-    /// Why this clip was chosen (substitutions are documented here).
-    #[serde(default)]
-    pub note: Option<String>,
-}
 
 /// Where the skeleton of DeepMimic clips comes from.
 #[derive(Debug, Clone, Deserialize)]
@@ -82,11 +73,11 @@ pub struct ClipLibrary {
     /// Skeleton source for DeepMimic clips.
     #[serde(default)]
     pub skeleton: Option<SkeletonSpec>,
-    /// Direction the rig faces in its clips (rig space, horizontal).
+    /// Direction the rig faces, in its root joint's frame (see [`ClipLibrary::forward`]).
     #[serde(default = "default_forward")]
     pub forward: [f32; 3],
-    /// Action name → clip.
-    pub actions: BTreeMap<String, ActionSpec>,
+    /// Action name → its clip variants.
+    pub actions: BTreeMap<String, ActionEntry>,
     /// Folder relative paths resolve against (the library file's folder).
     #[serde(skip)]
     pub base: Option<PathBuf>,
@@ -99,17 +90,21 @@ fn default_forward() -> [f32; 3] {
     [1.0, 0.0, 0.0]
 }
 
-/// A clip ready for assembly.
+/// A clip ready for assembly (one variant of an action).
 #[derive(Debug, Clone)]
 pub struct ActionClip {
     /// Action name.
     pub action: String,
+    /// Variant name (see [`ActionSpec::variant_name`]).
+    pub variant: String,
     /// The clip in metres, +Y up.
     pub clip: Clip,
     /// Travels along the doodle.
     pub moving: bool,
     /// Repeats in cycles.
     pub cyclic: bool,
+    /// Repeats seamlessly when the action outlasts the clip (see the module doc).
+    pub looping: bool,
     /// In place and anchored: the clip's net ground drift is removed.
     pub anchor: bool,
     /// The source clip file it was cut from (for motion-graph look-ups).
@@ -117,6 +112,21 @@ pub struct ActionClip {
     /// Seconds of the source file where this clip starts (its `frames` range); `None` when
     /// played ping-pong (its time then has no monotone map to the source's).
     pub source_start_s: Option<f32>,
+    /// Seconds of the source file the clip was cut from, (first, last) frame.
+    pub source_span_s: (f32, f32),
+    /// The variant's own Laban effort estimate from its Effort-component LMA features,
+    /// standardised over the action's variants (`None` when the action has one clip).
+    pub effort: Option<crate::graph::effort::Effort>,
+    /// The action's other variants, in library order (empty for a single clip). `self` is the
+    /// primary variant.
+    pub alternatives: Vec<ActionClip>,
+}
+
+impl ActionClip {
+    /// All variants: `self` first, then the alternatives.
+    pub fn variants(&self) -> impl Iterator<Item = &ActionClip> {
+        std::iter::once(self).chain(self.alternatives.iter())
+    }
 }
 
 impl ClipLibrary {
@@ -153,11 +163,12 @@ impl ClipLibrary {
         Ok(lib)
     }
 
-    /// Facing direction of the rig (unit, horizontal).
+    /// Facing direction of the rig in its root joint's frame (unit): the root's rotation
+    /// carries it to the world facing. DeepMimic's root frame is upright (+X); rigs whose root
+    /// frame is not (LAFAN's hips have +X up, +Z left) face along another axis (+Y).
     pub fn forward(&self) -> Vec3 {
         let f = Vec3::from(self.forward);
-        let f = Vec3::new(f.x, 0.0, f.z);
-        if f.length() > 1e-6 {
+        if f.is_finite() && f.length() > 1e-6 {
             f.normalize()
         } else {
             Vec3::X
@@ -231,7 +242,9 @@ impl ClipLibrary {
         Ok(Some((sk, urdf)))
     }
 
-    /// Loads the clips of the given actions (all must be mapped, see [`Self::check_actions`]).
+    /// Loads the clips of the given actions (all must be mapped, see [`Self::check_actions`]):
+    /// each action's primary variant, carrying the others as
+    /// [`ActionClip::alternatives`] with their effort estimates.
     pub fn load<'a>(
         &self,
         actions: impl IntoIterator<Item = &'a str>,
@@ -241,72 +254,138 @@ impl ClipLibrary {
         let urdf = self.skeleton_urdf()?;
         let mut out = BTreeMap::new();
         let mut names: Option<Vec<String>> = None;
+        // Variants often cut several ranges from one long take: read each file once.
+        let mut files: BTreeMap<PathBuf, (Clip, bool)> = BTreeMap::new();
         for action in wanted {
             if out.contains_key(action) {
                 continue;
             }
-            let Some(spec) = self.actions.get(action) else {
+            let Some(entry) = self.actions.get(action) else {
                 continue;
             };
-            let path = self.resolve(&spec.file)?;
-            let mut clip = if path
-                .extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
-            {
-                let mut c = read_bvh_path(&path)?.clip;
-                c.scale_lengths(spec.scale.unwrap_or(0.01));
-                c
-            } else {
-                let (sk, u) = urdf.as_ref().ok_or_else(|| {
-                    AnimError::Data(format!(
-                        "{}: DeepMimic clip {} needs a \"skeleton\" entry",
-                        self.origin, spec.file
-                    ))
-                })?;
-                let text = std::fs::read_to_string(&path).map_err(|e| AnimError::Io {
-                    path: path.clone(),
-                    reason: e.to_string(),
-                })?;
-                let mut c = read_deepmimic(&text, &path, sk, u)?.clip;
-                c.scale_lengths(spec.scale.unwrap_or(1.0));
-                c
-            };
-            clip.name = action.to_string();
-            let source_start_s = (!spec.pingpong)
-                .then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
-            select_frames(&mut clip, spec, &self.origin, action)?;
-            let joint_names: Vec<String> = clip
-                .skeleton
-                .joints
-                .iter()
-                .map(|j| j.name.clone())
-                .collect();
-            match &names {
-                None => names = Some(joint_names),
-                Some(n) if *n != joint_names => {
-                    return Err(AnimError::Data(format!(
+            check_variants(&entry.variants).map_err(|reason| AnimError::Spec {
+                path: PathBuf::from(&self.origin),
+                line: 1,
+                reason: format!("action {action}: {reason}"),
+            })?;
+            let mut loaded = Vec::with_capacity(entry.variants.len());
+            for spec in &entry.variants {
+                let ac = self.load_variant(action, spec, urdf.as_ref(), &mut files)?;
+                let joint_names: Vec<String> = ac
+                    .clip
+                    .skeleton
+                    .joints
+                    .iter()
+                    .map(|j| j.name.clone())
+                    .collect();
+                match &names {
+                    None => names = Some(joint_names),
+                    Some(n) if *n != joint_names => {
+                        return Err(AnimError::Data(format!(
                         "{}: clip for {action} ({}) has a different skeleton from the other clips",
                         self.origin, spec.file
                     )))
+                    }
+                    Some(_) => {}
                 }
-                Some(_) => {}
+                loaded.push(ac);
             }
-            out.insert(
-                action.to_string(),
-                ActionClip {
-                    action: action.to_string(),
-                    clip,
-                    moving: spec.moving,
-                    cyclic: spec.cyclic,
-                    anchor: spec.anchor && !spec.moving,
-                    file: path,
-                    source_start_s,
-                },
-            );
+            if loaded.len() > 1 {
+                super::variants::sign_variants(&mut loaded).map_err(|e| {
+                    AnimError::Data(format!(
+                        "{}: action {action}: effort features of its variants: {e}",
+                        self.origin
+                    ))
+                })?;
+            }
+            let mut it = loaded.into_iter();
+            if let Some(mut primary) = it.next() {
+                primary.alternatives = it.collect();
+                out.insert(action.to_string(), primary);
+            }
         }
         Ok(out)
     }
+
+    /// Reads a clip file as stored (its own length unit) and whether it says it loops.
+    fn read_clip(
+        &self,
+        path: &Path,
+        spec: &ActionSpec,
+        urdf: Option<&(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>,
+    ) -> Result<(Clip, bool), AnimError> {
+        if is_bvh_path(path) {
+            return Ok((read_bvh_path(path)?.clip, false));
+        }
+        let (sk, u) = urdf.ok_or_else(|| {
+            AnimError::Data(format!(
+                "{}: DeepMimic clip {} needs a \"skeleton\" entry",
+                self.origin, spec.file
+            ))
+        })?;
+        let text = std::fs::read_to_string(path).map_err(|e| AnimError::Io {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        let dm = read_deepmimic(&text, path, sk, u)?;
+        Ok((dm.clip, dm.looping))
+    }
+
+    /// Loads one variant's clip.
+    fn load_variant(
+        &self,
+        action: &str,
+        spec: &ActionSpec,
+        urdf: Option<&(Skeleton, Vec<crate::motion::urdf::UrdfJoint>)>,
+        files: &mut BTreeMap<PathBuf, (Clip, bool)>,
+    ) -> Result<ActionClip, AnimError> {
+        let path = self.resolve(&spec.file)?;
+        if !files.contains_key(&path) {
+            let read = self.read_clip(&path, spec, urdf)?;
+            files.insert(path.clone(), read);
+        }
+        let Some((clip, file_loops)) = files.get(&path) else {
+            return Err(AnimError::Data(format!(
+                "{}: lost {}",
+                self.origin, spec.file
+            )));
+        };
+        let (mut clip, file_loops) = (clip.clone(), *file_loops);
+        let scale = spec
+            .scale
+            .unwrap_or(if is_bvh_path(&path) { 0.01 } else { 1.0 });
+        clip.scale_lengths(scale);
+        clip.name = action.to_string();
+        let source_start_s =
+            (!spec.pingpong).then(|| spec.frames.map_or(0.0, |[a, _]| a as f32 * clip.frame_time));
+        let source_span_s = match spec.frames {
+            Some([a, b]) => (a as f32 * clip.frame_time, b as f32 * clip.frame_time),
+            None => (0.0, clip.duration()),
+        };
+        select_frames(&mut clip, spec, &self.origin, action)?;
+        let whole = spec.frames.is_none() && !spec.pingpong;
+        let looping = spec.looping.unwrap_or(spec.cyclic || (whole && file_loops));
+        Ok(ActionClip {
+            action: action.to_string(),
+            variant: spec.variant_name(),
+            clip,
+            moving: spec.moving,
+            cyclic: spec.cyclic,
+            looping: looping || spec.cyclic,
+            anchor: spec.anchor && !spec.moving,
+            file: path,
+            source_start_s,
+            source_span_s,
+            effort: None,
+            alternatives: Vec::new(),
+        })
+    }
+}
+
+fn is_bvh_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
 }
 
 fn select_frames(
@@ -366,6 +445,38 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("lib.json:4:"), "{err}");
+    }
+
+    #[test]
+    fn default_kick_variants_follow_the_effort() {
+        if crate::data::data_file("deepmimic", "humanoid.urdf").is_none() {
+            eprintln!("skipping: deepmimic data missing — run `cargo xtask setup`");
+            return;
+        }
+        let lib = ClipLibrary::default_library().unwrap();
+        let clips = lib.load(["kick", "punch"]).unwrap();
+        let kick = &clips["kick"];
+        let names: Vec<&str> = kick.variants().map(|v| v.variant.as_str()).collect();
+        assert_eq!(names, ["kick", "spinkick"]);
+        assert!(!kick.alternatives[0].looping, "spinkick has loop: false");
+        assert!(clips["punch"].alternatives.is_empty() && clips["punch"].effort.is_none());
+        let e = |t: f32, w: f32| crate::graph::effort::Effort { time: t, weight: w };
+        let pick = |t, w| {
+            super::super::variants::choose_variant(kick, e(t, w), None)
+                .0
+                .variant
+                .clone()
+        };
+        assert_eq!(pick(0.8, 0.8), "spinkick");
+        assert_eq!(pick(-0.8, -0.8), "kick");
+        // Stable: a second load decides the same.
+        let again = lib.load(["kick"]).unwrap();
+        let (v, c) = super::super::variants::choose_variant(&again["kick"], e(0.8, 0.8), None);
+        assert_eq!(v.variant, "spinkick");
+        assert_eq!(
+            c.unwrap().variant_effort,
+            kick.alternatives[0].effort.unwrap()
+        );
     }
 
     #[test]

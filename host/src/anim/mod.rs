@@ -2,12 +2,15 @@
 //! doodle's path to a full-body character animation.
 //!
 //! Data flow, one file per stage:
-//! [`library`] (action → clip) → [`phrasing`] (stages of each clip, §6.1) →
+//! [`library`] (action → clip variants; an entry's format in [`clip_spec`]) →
+//! [`variants`] (the variant matching the recognised effort) →
+//! [`phrasing`] (stages of each clip, §6.1) →
 //! [`effort`] (retime eq. 6, rescale eq. 7, weight arc length, reshape; §6.3–6.4) →
 //! [`trajectory`] (doodle → ground path, in-place offsets, cycles, jumps; §6.2) →
+//! [`looping`] (seamless repeats of looping clips) →
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
 //! [`contact`] (foot contacts, two-bone IK against ground penetration) →
-//! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages`).
+//! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
 //! [`plot`] draws contact sheets to look at the result.
 
 use std::path::PathBuf;
@@ -18,14 +21,17 @@ use crate::motion::MotionError;
 
 pub mod assemble;
 pub mod cli;
+pub mod clip_spec;
 pub mod contact;
 pub mod effort;
 pub mod graph_cuts;
 pub mod library;
+pub mod looping;
 pub mod phrasing;
 pub mod plot;
 pub mod trajectory;
 pub mod transition;
+pub mod variants;
 
 /// Why an animation could not be assembled.
 #[derive(Debug, Error)]

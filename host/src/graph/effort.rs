@@ -11,8 +11,9 @@
 //!   energy the body puts into the movement.
 //!
 //! The signs follow DESIGN.md's effort convention. [`MotionGraph::best_transition`] adds an
-//! effort match to the usual posture / style score, and [`rank_clips_by_effort`] orders clip
-//! variants of one action by how well their effort matches a recognised one.
+//! effort match to the usual posture / style score, and [`rank_clips_by_effort`] /
+//! [`rank_spans_by_effort`] order clip variants of one action by how well their effort matches
+//! a recognised one.
 
 use std::ops::Range;
 
@@ -73,16 +74,39 @@ impl MotionGraph {
 
     /// Mean effort of a clip's windows.
     pub fn clip_effort(&self, clip: usize) -> Option<Effort> {
+        self.clip_effort_between(clip, 0.0..f32::INFINITY)
+    }
+
+    /// Mean effort of the windows of clip `clip` centred within `span` (seconds from the
+    /// clip's start); when no window is centred there (a span shorter than a window, near an
+    /// end), the window nearest the span's middle. `None` if the clip has no full window.
+    pub fn clip_effort_between(&self, clip: usize, span: Range<f32>) -> Option<Effort> {
         let c = self.clips.get(clip)?;
+        let last = c.frames.checked_sub(1)?;
+        let frame = |t: f32| -> u32 {
+            if t.is_finite() {
+                (t * super::FPS).round().clamp(0.0, last as f32) as u32
+            } else if t > 0.0 {
+                last
+            } else {
+                0
+            }
+        };
+        let (f0, f1) = (frame(span.start), frame(span.end));
         let (mut t, mut w, mut n) = (0.0f32, 0.0f32, 0usize);
-        for f in c.start..c.start + c.frames {
-            if let Some(e) = self.effort_at(f) {
+        for f in f0..=f1.max(f0) {
+            if let Some(e) = self.effort_at(c.start + f) {
                 t += e.time;
                 w += e.weight;
                 n += 1;
             }
         }
-        (n > 0).then(|| Effort {
+        if n == 0 {
+            let (lo, hi) = (super::HALF as u32, last.checked_sub(super::HALF as u32)?);
+            let mid = ((f0 + f1.max(f0)) / 2).clamp(lo, hi.max(lo));
+            return self.effort_at(c.start + mid);
+        }
+        Some(Effort {
             time: t / n as f32,
             weight: w / n as f32,
         })
@@ -243,6 +267,28 @@ pub fn rank_clips_by_effort(
     out
 }
 
+/// Spans `(clip, seconds)` ordered by how well their mean effort
+/// ([`MotionGraph::clip_effort_between`]) matches `effort` (best first, ties by position):
+/// (index into `spans`, match ∈ [0, 1]); spans without a window are left out.
+pub fn rank_spans_by_effort(
+    graph: &MotionGraph,
+    spans: &[(usize, Range<f32>)],
+    effort: Effort,
+) -> Vec<(usize, f32)> {
+    let mut out: Vec<(usize, f32)> = spans
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (c, r))| {
+            Some((
+                i,
+                graph.clip_effort_between(*c, r.clone())?.matches(&effort),
+            ))
+        })
+        .collect();
+    out.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -273,6 +319,14 @@ mod tests {
         };
         assert_eq!(rank_clips_by_effort(&g, &[0, 1], strong)[0].0, 1);
         assert_eq!(rank_clips_by_effort(&g, &[0, 1], light)[0].0, 0);
+        // Spans: the same ranking through sub-ranges, a span shorter than a window included.
+        let spans = [(0, 0.5..0.6), (1, 0.0..3.0)];
+        assert_eq!(rank_spans_by_effort(&g, &spans, strong)[0].0, 1);
+        assert_eq!(rank_spans_by_effort(&g, &spans, light)[0].0, 0);
+        let whole = g.clip_effort(1).unwrap();
+        let part = g.clip_effort_between(1, 0.0..100.0).unwrap();
+        assert_eq!(whole, part);
+        assert!(g.clip_effort_between(5, 0.0..1.0).is_none());
     }
 
     #[test]
