@@ -101,11 +101,16 @@ impl MatcherBank {
     }
 }
 
-/// Whether `tokens`, read from their first, are an exact prefix of a match of `p` that has
-/// not ended (some position of the pattern is live and it is not only the accepting one): the
-/// gesture of `p` is under way and may go on. One forward step per token.
-pub fn prefix_alive(p: &Pattern<'_>, tokens: impl IntoIterator<Item = Token>) -> bool {
-    let mut d = 1u64;
+/// Whether `tokens`, read from their first, are an exact prefix of a match of `p` — after
+/// skipping the pattern's first part when `skip_first` (a punch begun without its wind-up) —
+/// that has not ended (some position of the pattern is live and it is not only the accepting
+/// one): the gesture of `p` is under way and may go on. One forward step per token.
+pub fn prefix_alive(
+    p: &Pattern<'_>,
+    tokens: impl IntoIterator<Item = Token>,
+    skip_first: bool,
+) -> bool {
+    let mut d = if skip_first { 1 | p.first() } else { 1 };
     for t in tokens {
         d = p.forward(d) & p.symbol_mask(t) & !1;
         if d == 0 {
@@ -255,10 +260,13 @@ mod tests {
         let blob = seq_library(&[(&["b", "f", "b"], 1)]);
         let lib = Library::from_bytes(&blob).unwrap();
         let p = lib.pattern(0).unwrap();
-        assert!(prefix_alive(&p, toks("b f")));
-        assert!(!prefix_alive(&p, toks("f b")));
+        assert!(prefix_alive(&p, toks("b f"), false));
+        assert!(!prefix_alive(&p, toks("f b"), false));
+        // Begun without its first part.
+        assert!(!prefix_alive(&p, toks("f"), false));
+        assert!(prefix_alive(&p, toks("f"), true));
         // Complete: nothing left to wait for.
-        assert!(!prefix_alive(&p, toks("b f b")));
+        assert!(!prefix_alive(&p, toks("b f b"), false));
     }
 
     #[test]

@@ -206,8 +206,9 @@ impl<'lib> Recognizer<'lib> {
         }
     }
 
-    /// Whether another action's exact match began up to [`HOLD_BACK_TOKENS`] tokens before
-    /// `p` (so it covers `p` and more) and is still under way: then a pause after `p` is a hold
+    /// Whether another action's match began with `p` (its own first part skipped) or, exactly,
+    /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
+    /// under way: then a pause after `p` is a hold
     /// inside that longer gesture — a punch held at full reach after its forward stroke.
     fn longer_in_progress(&self, p: &Candidate) -> bool {
         let hist = self.front.history();
@@ -219,6 +220,21 @@ impl<'lib> Recognizer<'lib> {
         let tokens_from = move |from: u32| {
             (0..=newest.wrapping_sub(from)).filter_map(move |k| moving(from.wrapping_add(k)))
         };
+        let alive_from = |start: u32, skip_first: bool| {
+            (0..self.library.len()).any(|a| {
+                a != usize::from(p.action)
+                    && self.library.pattern(a).is_some_and(|pat| {
+                        // Only an action needing more tokens than `p` has is a longer one.
+                        pat.min_len() > usize::from(p.len)
+                            && prefix_alive(&pat, tokens_from(start), skip_first)
+                    })
+            })
+        };
+        // Begun with the pending candidate, but without its own first part …
+        if alive_from(p.start, true) {
+            return true;
+        }
+        // … or exactly, a little earlier.
         let mut start = p.start;
         for _ in 0..HOLD_BACK_TOKENS {
             // The previous moving run before `start`, not below the floor.
@@ -234,15 +250,8 @@ impl<'lib> Recognizer<'lib> {
             };
             let Some(s) = prev else { return false };
             start = s;
-            for a in 0..self.library.len() {
-                if a == usize::from(p.action) {
-                    continue;
-                }
-                if let Some(pat) = self.library.pattern(a) {
-                    if prefix_alive(&pat, tokens_from(start)) {
-                        return true;
-                    }
-                }
+            if alive_from(start, false) {
+                return true;
             }
         }
         false
