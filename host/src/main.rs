@@ -49,7 +49,9 @@ enum Command {
 }
 
 fn main() -> anyhow::Result<()> {
-    match Cli::parse().command {
+    let cli = Cli::parse();
+    figurine_host::render::gpu::ensure_runtime_dir();
+    match cli.command {
         Command::Synth(a) => synth::cli::run(a)?,
         Command::Tokens(a) => recognize::tokens::run(&a)?,
         Command::Learn(a) => recognize::learn::run(&a)?,

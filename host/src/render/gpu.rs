@@ -26,6 +26,35 @@ pub const CPU_MSAA_MAX_PIXELS: u32 = 640 * 360;
 /// The MSAA sample count for a `width` × `height` target on `adapter`: [`MSAA_ENV`] if it is
 /// `1` or `4`; else [`SAMPLE_COUNT`], except 1 on a CPU adapter (lavapipe) for frames larger
 /// than [`CPU_MSAA_MAX_PIXELS`].
+/// Gives Mesa's window-system probing a private runtime directory when `XDG_RUNTIME_DIR` is
+/// unset or not a directory (a CI runner, a container, `sudo`), so headless rendering does
+/// not print "XDG_RUNTIME_DIR is invalid" on every device creation. Call it at program start,
+/// before any thread is spawned: it changes the process environment.
+pub fn ensure_runtime_dir() {
+    let valid = std::env::var_os("XDG_RUNTIME_DIR")
+        .map(std::path::PathBuf::from)
+        .is_some_and(|p| p.is_dir());
+    if valid {
+        return;
+    }
+    #[cfg(unix)]
+    let owner = {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata("/proc/self").map_or(0, |m| m.uid())
+    };
+    #[cfg(not(unix))]
+    let owner = 0;
+    let dir = std::env::temp_dir().join(format!("figurine-runtime-{owner}"));
+    if std::fs::create_dir_all(&dir).is_ok() {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+        }
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
+}
+
 pub fn msaa_samples(adapter: &wgpu::Adapter, width: u32, height: u32) -> u32 {
     match std::env::var(MSAA_ENV).ok().as_deref().map(str::trim) {
         Some("1") => return 1,
