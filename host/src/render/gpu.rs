@@ -23,9 +23,6 @@ pub const MSAA_ENV: &str = "FIGURINE_MSAA";
 /// 4× the frame time, which big frames cannot afford (and need less: their pixels are small).
 pub const CPU_MSAA_MAX_PIXELS: u32 = 640 * 360;
 
-/// The MSAA sample count for a `width` × `height` target on `adapter`: [`MSAA_ENV`] if it is
-/// `1` or `4`; else [`SAMPLE_COUNT`], except 1 on a CPU adapter (lavapipe) for frames larger
-/// than [`CPU_MSAA_MAX_PIXELS`].
 /// Gives Mesa's window-system probing a private runtime directory when `XDG_RUNTIME_DIR` is
 /// unset or not a directory (a CI runner, a container, `sudo`), so headless rendering does
 /// not print "XDG_RUNTIME_DIR is invalid" on every device creation. Call it at program start,
@@ -55,6 +52,9 @@ pub fn ensure_runtime_dir() {
     }
 }
 
+/// The MSAA sample count for a `width` × `height` target on `adapter`: [`MSAA_ENV`] if it is
+/// `1` or `4`; else [`SAMPLE_COUNT`], except 1 on a CPU adapter (lavapipe) for frames larger
+/// than [`CPU_MSAA_MAX_PIXELS`].
 pub fn msaa_samples(adapter: &wgpu::Adapter, width: u32, height: u32) -> u32 {
     match std::env::var(MSAA_ENV).ok().as_deref().map(str::trim) {
         Some("1") => return 1,
