@@ -54,7 +54,7 @@ fn step_pattern(p: &Pattern<'_>, d: &mut [u64; LEVELS], c: Token) -> Option<u8> 
     let mut init = 1u64;
     for (k, slot) in d.iter_mut().enumerate().take(k_max + 1) {
         if k > 0 {
-            init |= p.forward(init) & !1;
+            init |= p.forward_outlined(init) & !1;
         }
         let old = *slot;
         let mut new = p.forward(old | init) & b;
@@ -105,14 +105,10 @@ impl MatcherBank {
 /// skipping the pattern's first part when `skip_first` (a punch begun without its wind-up) —
 /// that has not ended (some position of the pattern is live and it is not only the accepting
 /// one): the gesture of `p` is under way and may go on. One forward step per token.
-pub fn prefix_alive(
-    p: &Pattern<'_>,
-    tokens: impl IntoIterator<Item = Token>,
-    skip_first: bool,
-) -> bool {
+pub fn prefix_alive(p: &Pattern<'_>, tokens: &[Token], skip_first: bool) -> bool {
     let mut d = if skip_first { 1 | p.first() } else { 1 };
-    for t in tokens {
-        d = p.forward(d) & p.symbol_mask(t) & !1;
+    for &t in tokens {
+        d = p.forward_outlined(d) & p.symbol_mask(t) & !1;
         if d == 0 {
             return false;
         }
@@ -260,13 +256,13 @@ mod tests {
         let blob = seq_library(&[(&["b", "f", "b"], 1)]);
         let lib = Library::from_bytes(&blob).unwrap();
         let p = lib.pattern(0).unwrap();
-        assert!(prefix_alive(&p, toks("b f"), false));
-        assert!(!prefix_alive(&p, toks("f b"), false));
+        assert!(prefix_alive(&p, &toks("b f"), false));
+        assert!(!prefix_alive(&p, &toks("f b"), false));
         // Begun without its first part.
-        assert!(!prefix_alive(&p, toks("f"), false));
-        assert!(prefix_alive(&p, toks("f"), true));
+        assert!(!prefix_alive(&p, &toks("f"), false));
+        assert!(prefix_alive(&p, &toks("f"), true));
         // Complete: nothing left to wait for.
-        assert!(!prefix_alive(&p, toks("b f b"), false));
+        assert!(!prefix_alive(&p, &toks("b f b"), false));
     }
 
     #[test]

@@ -108,11 +108,16 @@ impl Accum {
     /// Adds another accumulator.
     pub fn merge(&mut self, o: &Accum) {
         self.n = self.n.saturating_add(o.n);
-        for (s, &x) in self.sum.iter_mut().zip(&o.sum) {
-            *s += x;
-        }
-        for (s, &x) in self.sum_sq.iter_mut().zip(&o.sum_sq) {
-            *s += x;
+        for i in 0..QUANTITIES {
+            if let (Some(s), Some(s2), Some(x), Some(x2)) = (
+                self.sum.get_mut(i),
+                self.sum_sq.get_mut(i),
+                o.sum.get(i),
+                o.sum_sq.get(i),
+            ) {
+                *s += x;
+                *s2 += x2;
+            }
         }
     }
 }

@@ -137,6 +137,11 @@ impl<'a> Pattern<'a> {
         }
         out
     }
+    /// [`Pattern::forward`] kept out of line, for paths that are not per token (flash).
+    #[inline(never)]
+    pub fn forward_outlined(&self, d: u64) -> u64 {
+        self.forward(d)
+    }
     /// Backward transition: all states with a successor in `d`.
     pub fn backward(&self, d: u64) -> u64 {
         let mut out = 0u64;

@@ -210,51 +210,50 @@ impl<'lib> Recognizer<'lib> {
     /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
     /// under way: then a pause after `p` is a hold
     /// inside that longer gesture — a punch held at full reach after its forward stroke.
+    // Once per pause at most: kept out of the per-sample path (flash, not speed).
+    #[cold]
+    #[inline(never)]
     fn longer_in_progress(&self, p: &Candidate) -> bool {
+        // The moving runs from the floor to the newest, oldest first.
         let hist = self.front.history();
         let Some(newest) = hist.newest() else {
             return false;
         };
-        let moving = |i: u32| hist.get(i).filter(|r| r.token != STILL).map(|r| r.token);
-        // Runs from `from` to the newest, in order (STILL skipped).
-        let tokens_from = move |from: u32| {
-            (0..=newest.wrapping_sub(from)).filter_map(move |k| moving(from.wrapping_add(k)))
-        };
-        let alive_from = |start: u32, skip_first: bool| {
+        let mut tok = [STILL; HISTORY_RUNS];
+        let mut n = 0usize;
+        let mut at_start = None;
+        let mut i = self.floor;
+        for _ in 0..2 * HISTORY_RUNS {
+            if let Some(r) = hist.get(i).filter(|r| r.token != STILL) {
+                if i == p.start {
+                    at_start = Some(n);
+                }
+                if let Some(t) = tok.get_mut(n) {
+                    *t = r.token;
+                    n += 1;
+                }
+            }
+            if i == newest {
+                break;
+            }
+            i = i.wrapping_add(1);
+        }
+        let Some(ps) = at_start else { return false };
+        let moving = tok.get(..n).unwrap_or(&[]);
+        let alive_from = |from: usize, skip_first: bool| {
+            let tokens = moving.get(from..).unwrap_or(&[]);
             (0..self.library.len()).any(|a| {
                 a != usize::from(p.action)
                     && self.library.pattern(a).is_some_and(|pat| {
                         // Only an action needing more tokens than `p` has is a longer one.
-                        pat.min_len() > usize::from(p.len)
-                            && prefix_alive(&pat, tokens_from(start), skip_first)
+                        pat.min_len() > usize::from(p.len) && prefix_alive(&pat, tokens, skip_first)
                     })
             })
         };
-        // Begun with the pending candidate, but without its own first part …
-        if alive_from(p.start, true) {
-            return true;
-        }
-        // … or exactly, a little earlier.
-        let mut start = p.start;
-        for _ in 0..HOLD_BACK_TOKENS {
-            // The previous moving run before `start`, not below the floor.
-            let mut i = start;
-            let prev = loop {
-                if i == self.floor {
-                    break None;
-                }
-                i = i.wrapping_sub(1);
-                if moving(i).is_some() {
-                    break Some(i);
-                }
-            };
-            let Some(s) = prev else { return false };
-            start = s;
-            if alive_from(start, false) {
-                return true;
-            }
-        }
-        false
+        // Begun with the pending candidate, but without its own first part, or exactly a
+        // little earlier.
+        alive_from(ps, true)
+            || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
     fn release(&mut self, emit: &mut impl FnMut(ActionEvent)) {
