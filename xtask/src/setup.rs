@@ -6,6 +6,7 @@
 //!   (MP4 output), `python3-venv`, `nodejs` + `npm` (independent BVH and glTF validators).
 //! * Validators used by tests: Python's `bvh` package in `target/tools/pyenv`, Khronos'
 //!   `gltf-validator` from npm in `target/tools/node`.
+//! * cargo-fuzz from crates.io when missing (the fuzz smoke of `cargo xtask test`).
 //! * Real data from the package registries (see `data.rs`).
 
 use std::process::Command;
@@ -113,6 +114,9 @@ pub fn setup() -> Result<()> {
             .arg("gltf-validator@2.0.0-dev.3.10"))?;
     }
     println!("validators ready in {}", tools.display());
+
+    step("setup: cargo-fuzz");
+    crate::fuzz::install()?;
 
     crate::data::fetch()?;
     Ok(())
