@@ -2,86 +2,13 @@
 //! non-zero exit, never a panic or a backtrace. Inputs that are odd but legal (NaN samples,
 //! huge numbers) may succeed — the recognizer counts and skips them — but must not panic.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod malformed;
 
-fn figurine() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_figurine"));
-    c.env("RUST_BACKTRACE", "1");
-    c
-}
-
-/// A scratch folder unique to one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("figurine-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Malformed contents, by name. `None` contents = the path does not exist.
-fn bad_files(dir: &Path, ext: &str) -> Vec<(String, PathBuf)> {
-    let junk: Vec<u8> = (0..2048u32)
-        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
-        .collect();
-    let header = "t,x,y,z,qw,qx,qy,qz\n";
-    let cases: Vec<(&str, Vec<u8>)> = vec![
-        ("empty", Vec::new()),
-        ("binary", junk),
-        ("wrong-columns", b"time;pos;rot\n1;2;3\n".to_vec()),
-        (
-            "truncated",
-            format!("{header}0.0,1,2,3,1,0,0,0\n0.01,1,2").into_bytes(),
-        ),
-        (
-            "text-in-numbers",
-            format!("{header}0.0,one,2,3,1,0,0,0\n").into_bytes(),
-        ),
-        (
-            "json-newer-version",
-            br#"{"format":"figurine-library","version":99,"actions":[]}"#.to_vec(),
-        ),
-        (
-            "json-truncated",
-            br#"{"format":"figurine-library","version":1,"act"#.to_vec(),
-        ),
-        (
-            "bvh-truncated",
-            b"HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition".to_vec(),
-        ),
-    ];
-    let mut out: Vec<(String, PathBuf)> = cases
-        .into_iter()
-        .map(|(name, bytes)| {
-            let p = dir.join(format!("{name}.{ext}"));
-            std::fs::write(&p, bytes).unwrap();
-            (name.to_string(), p)
-        })
-        .collect();
-    out.push(("missing".into(), dir.join(format!("does-not-exist.{ext}"))));
-    let d = dir.join(format!("a-directory.{ext}"));
-    std::fs::create_dir_all(&d).unwrap();
-    out.push(("directory".into(), d));
-    out
-}
+use malformed::{bad_files, figurine, name_of, scratch};
 
 /// Runs one case and checks it failed cleanly, naming `file`.
-fn assert_clean_failure(args: &[&std::ffi::OsStr], file: &Path, case: &str) {
-    let out = figurine().args(args).output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let shown = format!(
-        "figurine {:?} [{case}]: status {:?}\nstderr: {stderr}",
-        args, out.status
-    );
-    assert!(!stderr.contains("panicked"), "panic: {shown}");
-    assert!(!stderr.contains("stack backtrace"), "backtrace: {shown}");
-    assert!(!out.status.success(), "accepted malformed input: {shown}");
-    assert_eq!(out.status.code(), Some(1), "{shown}");
-    let name = file.file_name().unwrap().to_string_lossy();
-    assert!(
-        stderr.contains(name.as_ref()),
-        "error does not name the file: {shown}"
-    );
+fn assert_clean_failure(args: &[&std::ffi::OsStr], file: &std::path::Path, case: &str) {
+    malformed::assert_clean_failure(args, &name_of(file), case);
 }
 
 #[test]

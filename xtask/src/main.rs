@@ -8,11 +8,13 @@
 //! * `e2e` — the firmware in QEMU against the host.
 //! * `soak --seconds N --rate HZ` — a long pose stream into the QEMU firmware.
 //! * `firmware --board qemu|nrf52840` — builds the firmware binary.
-//! * `fuzz --seconds N` — runs every cargo-fuzz target for N seconds (nightly).
+//! * `fuzz [--seconds N] [--runs N] [--target T]` — runs the cargo-fuzz targets on the pinned
+//!   stable toolchain (`RUSTC_BOOTSTRAP=1`); `test` runs a short smoke of every target.
 
 mod bench;
 mod data;
 mod demo;
+mod fuzz;
 mod setup;
 mod tasks;
 mod util;
@@ -60,11 +62,18 @@ enum Cmd {
         #[arg(long)]
         debug: bool,
     },
-    /// Run each fuzz target for a while (needs the nightly toolchain; installs cargo-fuzz).
+    /// Run every cargo-fuzz target (pinned stable toolchain, no nightly; installs cargo-fuzz).
+    /// Fails on any crash; prints executions per target.
     Fuzz {
-        /// Seconds per target.
-        #[arg(long, default_value_t = 20)]
+        /// Seconds per target (at most).
+        #[arg(long, default_value_t = fuzz::SMOKE_SECONDS)]
         seconds: u64,
+        /// Executions per target (at most; 0: no limit), e.g. 10000000 for a campaign.
+        #[arg(long, default_value_t = 0)]
+        runs: u64,
+        /// Only this target (repeatable); default: all.
+        #[arg(long = "target")]
+        targets: Vec<String>,
     },
 }
 
@@ -79,6 +88,14 @@ fn main() -> anyhow::Result<()> {
         Cmd::Soak { seconds, rate } => tasks::soak(seconds, rate),
         Cmd::Test => tasks::test(),
         Cmd::Firmware { board, debug } => tasks::firmware(board, !debug),
-        Cmd::Fuzz { seconds } => tasks::fuzz(seconds),
+        Cmd::Fuzz {
+            seconds,
+            runs,
+            targets,
+        } => fuzz::fuzz(&fuzz::FuzzOptions {
+            seconds,
+            runs,
+            targets,
+        }),
     }
 }

@@ -3,9 +3,11 @@
 //! * Rust: the `thumbv7em-none-eabihf` target and `llvm-tools` for the pinned toolchain.
 //! * Debian packages, installed only when missing: `qemu-system-arm` (firmware end-to-end
 //!   tests), `mesa-vulkan-drivers` + `libvulkan1` (lavapipe, headless rendering), `ffmpeg`
-//!   (MP4 output), `python3-venv`, `nodejs` + `npm` (independent BVH and glTF validators).
+//!   (MP4 output), `python3-venv`, `nodejs` + `npm` (independent BVH and glTF validators),
+//!   `g++` (libFuzzer, which cargo-fuzz builds from C++ sources).
 //! * Validators used by tests: Python's `bvh` package in `target/tools/pyenv`, Khronos'
 //!   `gltf-validator` from npm in `target/tools/node`.
+//! * cargo-fuzz from crates.io when missing (the fuzz smoke of `cargo xtask test`).
 //! * Real data from the package registries (see `data.rs`).
 
 use std::process::Command;
@@ -23,6 +25,7 @@ const APT_PACKAGES: &[(&str, &str)] = &[
     ("python3-venv", ""),
     ("nodejs", "node"),
     ("npm", "npm"),
+    ("g++", "g++"),
 ];
 
 fn dpkg_installed(pkg: &str) -> bool {
@@ -113,6 +116,9 @@ pub fn setup() -> Result<()> {
             .arg("gltf-validator@2.0.0-dev.3.10"))?;
     }
     println!("validators ready in {}", tools.display());
+
+    step("setup: cargo-fuzz");
+    crate::fuzz::install()?;
 
     crate::data::fetch()?;
     Ok(())

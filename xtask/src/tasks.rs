@@ -1,11 +1,11 @@
-//! The composite tasks: test, firmware, fuzz.
+//! The composite tasks: test, firmware, end-to-end, soak.
 
 use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 
-use crate::util::{cargo, have, root, run, step};
+use crate::util::{cargo, root, run, step};
 
 /// A firmware board.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -158,6 +158,13 @@ pub fn test() -> Result<()> {
 
     step("tests (workspace, including end-to-end)");
     let (passed, failed) = run_tests(cargo().args(["test", "--workspace", "--no-fail-fast"]))?;
+
+    step("fuzz smoke: every target");
+    crate::fuzz::fuzz(&crate::fuzz::FuzzOptions {
+        seconds: crate::fuzz::SMOKE_SECONDS,
+        runs: 0,
+        targets: Vec::new(),
+    })?;
     println!(
         "\nall checks passed in {:.0} s",
         start.elapsed().as_secs_f64()
@@ -200,103 +207,4 @@ fn run_tests(cmd: &mut Command) -> Result<(u64, u64)> {
         anyhow::bail!("tests failed ({status}): {shown}");
     }
     Ok((passed, failed))
-}
-
-/// Real files that seed a fuzz corpus: `(data subfolder, file-name suffix)`; a folder
-/// starting with `@` is in the repository instead of the data folder. The LAFAN-derived files
-/// may not be committed, so these seeds are copied in at run time.
-type RealSeeds = &'static [(&'static str, &'static str)];
-
-/// Fuzz targets: (fuzz crate folder, target name, real-data seeds).
-const FUZZ_TARGETS: &[(&str, &str, RealSeeds)] = &[
-    ("protocol/fuzz", "decode_stream", &[]),
-    ("host/fuzz", "poselog_csv", &[]),
-    ("host/fuzz", "bvh_import", &[("bvh", ".bvh")]),
-    (
-        "host/fuzz",
-        "deepmimic_import",
-        &[("deepmimic", ".txt"), ("deepmimic", ".urdf")],
-    ),
-    ("host/fuzz", "events_jsonl", &[]),
-    (
-        "host/fuzz",
-        "library_json",
-        &[("@host/assets", "library.json")],
-    ),
-    (
-        "host/fuzz",
-        "effort_json",
-        &[("@host/assets", "effort.json")],
-    ),
-    ("firmware/recognizer/fuzz", "sample_feed", &[]),
-    ("firmware/recognizer/fuzz", "blobs", &[]),
-];
-
-/// Runs every fuzz target for `seconds`; prints each target's execution count.
-pub fn fuzz(seconds: u64) -> Result<()> {
-    if !have("cargo-fuzz") {
-        step("installing cargo-fuzz");
-        run(Command::new("cargo").args(["+nightly", "install", "--locked", "cargo-fuzz"]))?;
-    }
-    let data = crate::data::data_dir();
-    let mut summary = Vec::new();
-    for (dir, target, real_seeds) in FUZZ_TARGETS {
-        let dir = root().join(dir);
-        step(&format!("fuzz {target} for {seconds} s"));
-        let corpus = dir.join("corpus").join(target);
-        std::fs::create_dir_all(&corpus)?;
-        for (sub, suffix) in *real_seeds {
-            for entry in std::fs::read_dir(data.join(sub))
-                .into_iter()
-                .flatten()
-                .flatten()
-            {
-                let p = entry.path();
-                let small = entry.metadata().is_ok_and(|m| m.len() < 512 * 1024);
-                if small && p.to_string_lossy().ends_with(suffix) {
-                    if let Some(name) = p.file_name() {
-                        std::fs::copy(&p, corpus.join(name))?;
-                    }
-                }
-            }
-        }
-        let seeds = dir.join("seeds").join(target);
-        let mut cmd = Command::new("cargo");
-        cmd.current_dir(&dir)
-            .args(["+nightly", "fuzz", "run", target])
-            .arg(&corpus);
-        if seeds.exists() {
-            cmd.arg(&seeds);
-        }
-        cmd.args([
-            "--",
-            &format!("-max_total_time={seconds}"),
-            "-print_final_stats=1",
-        ]);
-        let out = cmd
-            .output()
-            .with_context(|| format!("could not start {cmd:?}"))?;
-        let log = String::from_utf8_lossy(&out.stderr);
-        let execs = log
-            .lines()
-            .find_map(|l| l.strip_prefix("stat::number_of_executed_units:"))
-            .map(|n| n.trim().to_string())
-            .unwrap_or_else(|| "?".into());
-        if !out.status.success() {
-            eprintln!("{log}");
-            anyhow::bail!(
-                "fuzz target {target} failed (a crash is saved under {}/artifacts)",
-                dir.display()
-            );
-        }
-        println!("{target}: {execs} executions, no crash");
-        summary.push(format!(
-            "{target}: {execs} executions in {seconds} s, 0 crashes"
-        ));
-    }
-    step("fuzz summary");
-    for line in summary {
-        println!("{line}");
-    }
-    Ok(())
 }

@@ -51,6 +51,10 @@ use crate::poselog::PoseLog;
 /// Fastest playback of a clip relative to its own speed (before effort retiming).
 pub const MAX_SPEEDUP: f32 = 3.0;
 
+/// Most frames an assembled animation may have (two hours at 30 fps; ≈ 360 MB of poses for a
+/// 60-joint rig): events whose times span more are refused rather than exhausting memory.
+pub const MAX_OUTPUT_FRAMES: usize = 216_000;
+
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AssembleOptions {
@@ -235,6 +239,16 @@ pub fn assemble_guided(
         None => first_event.min(0.0),
     };
     let fps = opts.fps;
+    let last_end = evs.iter().map(|e| e.end).fold(t_shift, f64::max);
+    let span_frames = (last_end - t_shift) * f64::from(fps);
+    if span_frames.is_nan() || span_frames > MAX_OUTPUT_FRAMES as f64 {
+        return Err(AnimError::Data(format!(
+            "the actions span {:.6e} s (from {t_shift} s to {last_end} s of the log clock): \
+             {span_frames:.3e} frames at {fps} fps, more than the {MAX_OUTPUT_FRAMES} an \
+             animation may have",
+            last_end - t_shift
+        )));
+    }
     let frame_of = |t: f64| ((t - t_shift) as f32 * fps).round().max(0.0) as usize;
 
     let skeleton = clips
@@ -300,6 +314,13 @@ pub fn assemble_guided(
         let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
         let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
         let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        if f1 > MAX_OUTPUT_FRAMES {
+            return Err(AnimError::Data(format!(
+                "action {} at {} s would end at frame {f1}, past the {MAX_OUTPUT_FRAMES} frames \
+                 an animation may have",
+                ev.action, ev.start
+            )));
+        }
         let duration = (f1 - f0) as f32 / fps;
         let (poses, world_path, cycles, src_times) =
             place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);

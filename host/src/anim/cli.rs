@@ -158,6 +158,17 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
              to recognise"
         ),
     };
+    // Where the events came from, for error messages.
+    let source = args
+        .events
+        .as_ref()
+        .or(args.labels.as_ref())
+        .or(args.log.as_ref())
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    if events.is_empty() {
+        bail!("{source}: no actions to animate (no events in it)");
+    }
     let doodle_path = args.doodle.as_ref().or(args.log.as_ref());
     let doodle = doodle_path.map(|p| PoseLog::read_path(p)).transpose()?;
     let library = match &args.clips {
@@ -179,7 +190,8 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
         library.forward(),
         &opts,
         guide.as_ref(),
-    )?;
+    )
+    .with_context(|| format!("animating the actions of {source}"))?;
     write_bvh_path(&asm.clip, &args.out)?;
     if let Some(glb) = &args.glb {
         write_glb_path(&asm.clip, 1.0, glb)?;

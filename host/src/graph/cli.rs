@@ -14,7 +14,7 @@ use super::roles::{read_overrides, RoleOverrides};
 use super::source::{load_clip, load_clips};
 use super::style::ComponentWeights;
 use super::synth::{best_start, plan, reference_style, render, Chooser, Rng};
-use super::{GraphError, FPS};
+use super::{GraphError, FPS, WINDOW};
 
 /// Style-coherent motion graphs (seed 003).
 #[derive(Args, Debug)]
@@ -158,8 +158,25 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     let weights = ComponentWeights::parse(&a.weights).map_err(anyhow::Error::msg)?;
     let roles = overrides(a.roles.as_deref())?;
     let files = expand_inputs(&a.clips)?;
+    let given = || {
+        a.clips
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    anyhow::ensure!(
+        !files.is_empty(),
+        "no clip files (.bvh, DeepMimic .txt) in {}",
+        given()
+    );
     let t0 = Instant::now();
     let clips = load_clips(&files, &roles)?;
+    anyhow::ensure!(
+        !clips.is_empty(),
+        "no clip in {} is at least one window ({WINDOW} frames at {FPS} fps) long; nothing to build",
+        given()
+    );
     let rigs: std::collections::BTreeSet<String> = clips.iter().map(|c| c.rig_key()).collect();
     if rigs.len() > 1 {
         eprintln!(

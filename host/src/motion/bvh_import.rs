@@ -7,6 +7,7 @@
 //! [`BvhImport::notes`]). Frames must be one per line. Anything else that is malformed is an
 //! error naming the file and the 1-based line.
 
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
@@ -17,6 +18,15 @@ use super::MotionError;
 
 /// Deepest joint nesting accepted (real rigs have < 20 levels; the parser recurses per level).
 pub const MAX_DEPTH: usize = 256;
+
+/// Most joints (end sites included) a hierarchy may declare. Real rigs have 20–300 (with
+/// fingers and face); the bound keeps a malformed file from multiplying into huge poses.
+pub const MAX_JOINTS: usize = 1024;
+
+/// Most joint poses (frames × joints) a file may hold: 2²⁴ ≈ 16.8 M (≈ 470 MB of poses), e.g.
+/// an hour of 120 fps capture on a 38-joint rig. A file with more is refused, naming the first
+/// frame line beyond the bound, before any frame is built.
+pub const MAX_FRAME_JOINTS: usize = 1 << 24;
 
 /// The result of importing a BVH file.
 #[derive(Debug, Clone)]
@@ -55,6 +65,8 @@ pub fn read_bvh(text: &str, path: &Path) -> Result<BvhImport, MotionError> {
         tokens: Vec::new(),
         tok: 0,
         joints: Vec::new(),
+        names: HashSet::new(),
+        next_suffix: HashMap::new(),
     };
     p.parse_hierarchy()?;
     let skeleton = Skeleton {
@@ -65,6 +77,25 @@ pub fn read_bvh(text: &str, path: &Path) -> Result<BvhImport, MotionError> {
         .map_err(|reason| p.err_at(p.line.max(1), reason))?;
     let (declared, frame_time, first_data) = p.parse_motion_header()?;
     let n_channels: usize = p.joints.iter().map(|j| j.joint.channels.len()).sum();
+    // Counted before any frame is built, so an oversized file fails without allocating.
+    let max_frames = MAX_FRAME_JOINTS / p.joints.len().max(1);
+    let beyond = lines
+        .iter()
+        .enumerate()
+        .skip(first_data)
+        .filter(|(_, l)| !l.trim().is_empty())
+        .nth(max_frames);
+    if let Some((idx, _)) = beyond {
+        return Err(MotionError::parse(
+            path,
+            idx + 1,
+            format!(
+                "more than {max_frames} frames of {} joints (at most {MAX_FRAME_JOINTS} joint \
+                 poses per file)",
+                p.joints.len()
+            ),
+        ));
+    }
     let mut frames = Vec::new();
     let mut values: Vec<f32> = Vec::with_capacity(n_channels);
     for (idx, raw) in lines.iter().enumerate().skip(first_data) {
@@ -177,6 +208,10 @@ struct Parser<'a> {
     tokens: Vec<String>,
     tok: usize,
     joints: Vec<ParsedJoint>,
+    /// Every joint name given so far, for constant-time uniqueness checks.
+    names: HashSet<String>,
+    /// Per duplicated base name, the next `#N` suffix to try.
+    next_suffix: HashMap<String, usize>,
 }
 
 impl Parser<'_> {
@@ -270,15 +305,31 @@ impl Parser<'_> {
         d
     }
 
-    fn unique_name(&self, base: &str) -> String {
-        let taken = |n: &str| self.joints.iter().any(|j| j.joint.name == n);
-        if !taken(base) {
-            return base.to_string();
+    /// `base`, or `base#N` with the smallest free N ≥ 2 when `base` is taken; the name is
+    /// reserved. Amortised constant time per joint, so many same-named joints stay linear.
+    fn unique_name(&mut self, base: &str) -> String {
+        let name = if self.names.contains(base) {
+            let next = self.next_suffix.entry(base.to_string()).or_insert(2);
+            loop {
+                let candidate = format!("{base}#{next}");
+                *next += 1;
+                if !self.names.contains(&candidate) {
+                    break candidate;
+                }
+            }
+        } else {
+            base.to_string()
+        };
+        self.names.insert(name.clone());
+        name
+    }
+
+    /// Refuses a joint beyond [`MAX_JOINTS`].
+    fn check_joint_count(&self) -> Result<(), MotionError> {
+        if self.joints.len() >= MAX_JOINTS {
+            return Err(self.err(format!("more than {MAX_JOINTS} joints")));
         }
-        (2..)
-            .map(|i| format!("{base}#{i}"))
-            .find(|n| !taken(n))
-            .unwrap_or_else(|| base.to_string())
+        Ok(())
     }
 
     fn parse_joint(&mut self, parent: Option<usize>) -> Result<(), MotionError> {
@@ -286,6 +337,7 @@ impl Parser<'_> {
         if depth > MAX_DEPTH {
             return Err(self.err(format!("joints nested deeper than {MAX_DEPTH}")));
         }
+        self.check_joint_count()?;
         let mut name_toks = self.rest_of_line();
         let brace_on_line = name_toks.last().map(|t| t == "{").unwrap_or(false);
         if brace_on_line {
@@ -357,6 +409,7 @@ impl Parser<'_> {
             self.number("OFFSET")?,
         );
         self.expect("}")?;
+        self.check_joint_count()?;
         let base = self
             .joints
             .get(parent)
@@ -529,6 +582,52 @@ mod tests {
         assert!(read_bvh("HIERARCHY\nMOTION\n", Path::new("e.bvh")).is_err());
         let cut = &SMALL[..SMALL.find("MOTION").unwrap_or(0)];
         assert!(read_bvh(cut, Path::new("e.bvh")).is_err());
+    }
+
+    /// A root with `n` children all named `a` (1 channel each), then `frames` frame lines.
+    fn many_joints(n: usize, frames: usize) -> String {
+        let mut t = String::from("HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n");
+        t.push_str(&"JOINT a\n{\nOFFSET 0 1 0\nCHANNELS 0\n}\n".repeat(n));
+        t.push_str(&format!("}}\nMOTION\nFrames: {frames}\nFrame Time: 0.01\n"));
+        t.push_str(&"0\n".repeat(frames));
+        t
+    }
+
+    #[test]
+    fn same_named_joints_get_unique_names() {
+        let imp = read_bvh(&many_joints(1000, 2), Path::new("same.bvh")).unwrap();
+        let names: Vec<&str> = imp
+            .clip
+            .skeleton
+            .joints
+            .iter()
+            .map(|j| j.name.as_str())
+            .collect();
+        assert_eq!(&names[..4], ["r", "a", "a#2", "a#3"]);
+        assert_eq!(names[1000], "a#1000");
+        // A literal `a#2` already taken: the duplicate gets the next free suffix.
+        let text = SMALL.replace("JOINT Left Leg", "JOINT Hips");
+        let imp = read_bvh(&text, Path::new("dup.bvh")).unwrap();
+        assert_eq!(imp.clip.skeleton.joints[1].name, "Hips#2");
+    }
+
+    #[test]
+    fn oversized_hierarchies_and_frame_counts_fail_fast() {
+        let err = read_bvh(&many_joints(MAX_JOINTS, 1), Path::new("wide.bvh"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("more than 1024 joints"), "{err}");
+        // 2 bytes per frame line would otherwise become 1000 joint poses each.
+        let frames = MAX_FRAME_JOINTS / 1001 + 1;
+        let err = read_bvh(&many_joints(1000, frames), Path::new("long.bvh"))
+            .unwrap_err()
+            .to_string();
+        let first_frame_line = 5 + 5 * 1000 + 5;
+        assert!(
+            err.starts_with(&format!("long.bvh:{}:", first_frame_line + frames - 1)),
+            "{err}"
+        );
+        assert!(err.contains("joint poses"), "{err}");
     }
 
     #[test]

@@ -314,7 +314,7 @@ pub fn read_dir(dir: &Path) -> Result<Vec<Example>> {
 /// `figurine train-effort`.
 pub fn run(args: &TrainEffortArgs) -> Result<()> {
     let ex = read_dir(&args.dir)?;
-    let t = train(&ex)?;
+    let t = train(&ex).with_context(|| format!("training from {}", args.dir.display()))?;
     t.file.write(&args.out)?;
     for (a, (name, ax)) in [("Time", &t.file.time), ("Weight", &t.file.weight)]
         .iter()
