@@ -136,20 +136,21 @@ pub fn choose_variant<'a>(
         time: f(want.time),
         weight: f(want.weight),
     };
-    if let Some(g) = guide {
-        if let Some((i, m, e)) = graph_choice(&all, want, g) {
-            return (
-                all[i],
-                Some(VariantChoice {
-                    index: i,
-                    name: all[i].variant.clone(),
-                    effort_match: m,
-                    variant_effort: e,
-                    by_graph: true,
-                    of: all.len(),
-                }),
-            );
-        }
+    let chosen = |(i, m, e): (usize, f32, Effort), by_graph: bool| {
+        (
+            all[i],
+            Some(VariantChoice {
+                index: i,
+                name: all[i].variant.clone(),
+                effort_match: m,
+                variant_effort: e,
+                by_graph,
+                of: all.len(),
+            }),
+        )
+    };
+    if let Some(c) = guide.and_then(|g| graph_choice(&all, want, g)) {
+        return chosen(c, true);
     }
     let scored: Vec<(usize, f32, Effort)> = all
         .iter()
@@ -159,18 +160,7 @@ pub fn choose_variant<'a>(
             (i, e.matches(&want), e)
         })
         .collect();
-    let (i, m, e) = pick(&scored).unwrap_or((0, 0.0, Effort::default()));
-    (
-        all[i],
-        Some(VariantChoice {
-            index: i,
-            name: all[i].variant.clone(),
-            effort_match: m,
-            variant_effort: e,
-            by_graph: false,
-            of: all.len(),
-        }),
-    )
+    chosen(pick(&scored).unwrap_or((0, 0.0, Effort::default())), false)
 }
 
 /// The graph's ranking, if it knows every variant: (index, match, variant effort).
