@@ -208,8 +208,8 @@ impl<'lib> Recognizer<'lib> {
 
     /// Whether another action's match began with `p` (its own first part skipped) or, exactly,
     /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
-    /// under way: then a pause after `p` is a hold
-    /// inside that longer gesture — a punch held at full reach after its forward stroke.
+    /// under way: then a pause after `p` is a hold inside that longer gesture — a punch held at
+    /// full reach after its forward stroke.
     // Once per pause at most: kept out of the per-sample path (flash, not speed).
     #[cold]
     #[inline(never)]
