@@ -47,5 +47,21 @@ pub fn have(prog: &str) -> bool {
 pub fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     c.current_dir(root());
+    // Tests that render in-process create Vulkan devices; without a runtime directory (CI
+    // runners, containers) Mesa prints "XDG_RUNTIME_DIR is invalid" for each of them.
+    let valid = std::env::var_os("XDG_RUNTIME_DIR")
+        .map(std::path::PathBuf::from)
+        .is_some_and(|p| p.is_dir());
+    if !valid {
+        let dir = root().join("target/runtime");
+        if std::fs::create_dir_all(&dir).is_ok() {
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+            }
+            c.env("XDG_RUNTIME_DIR", dir);
+        }
+    }
     c
 }
