@@ -239,16 +239,20 @@ fn synthetic_loop(frames: usize) -> ActionClip {
 
 #[test]
 fn a_synthetic_loop_wraps_without_snapping_back() {
+    // A 4-s stride event over whatever clip the library holds for it.
+    let play = |clips: &BTreeMap<_, _>| {
+        assemble(
+            &[event("stride", 0.0, 4.0, 0.0, 0.0)],
+            None,
+            clips,
+            Vec3::X,
+            &AssembleOptions::default(),
+        )
+        .unwrap()
+    };
     let mut clips = BTreeMap::new();
     clips.insert("stride".to_string(), synthetic_loop(31));
-    let asm = assemble(
-        &[event("stride", 0.0, 4.0, 0.0, 0.0)],
-        None,
-        &clips,
-        Vec3::X,
-        &AssembleOptions::default(),
-    )
-    .unwrap();
+    let asm = play(&clips);
     let p = &asm.placements[0];
     assert_eq!(p.cycles, 4, "4 s of a 1 s loop");
     let path = root_path(&asm, p.start_frame, p.end_frame);
@@ -264,14 +268,7 @@ fn a_synthetic_loop_wraps_without_snapping_back() {
     let mut once = synthetic_loop(31);
     once.looping = false;
     clips.insert("stride".to_string(), once);
-    let slow = assemble(
-        &[event("stride", 0.0, 4.0, 0.0, 0.0)],
-        None,
-        &clips,
-        Vec3::X,
-        &AssembleOptions::default(),
-    )
-    .unwrap();
+    let slow = play(&clips);
     let p = &slow.placements[0];
     let path = root_path(&slow, p.start_frame, p.end_frame);
     assert!((path[path.len() - 1].x - path[0].x - 1.0).abs() < 0.05);
