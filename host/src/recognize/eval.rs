@@ -9,7 +9,7 @@
 //!   performance most) is the right action, and the confusions;
 //! - Time, Weight and state accuracy of the correctly recognised isolated gestures;
 //! - sequences: events matched to labels (same action, overlapping in time, one-to-one),
-//!   precision, recall and F1;
+//!   precision, recall and F1, and why the unmatched events did not match ([`ExtraKind`]);
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
 
@@ -63,7 +63,8 @@ pub struct EvalArgs {
     /// Save the trained effort model here.
     #[arg(long)]
     pub save_effort: Option<PathBuf>,
-    /// Print the token string of every misrecognised isolated gesture.
+    /// Print the token string of every misrecognised isolated gesture, and every sequence
+    /// event that matched no gesture (with why).
     #[arg(long)]
     pub verbose: bool,
 }
@@ -173,6 +174,67 @@ pub struct Figures {
     pub latencies: Vec<f64>,
     /// Confusions: (truth, recognised-as or "none", count).
     pub confusions: Vec<(String, String, usize)>,
+    /// Sequence events that match no label (the false positives of the F1), by kind.
+    pub extra: ExtraEvents,
+}
+
+/// Sequence events that match no label, counted by why.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ExtraEvents {
+    /// Same action as a gesture it overlaps whose label already has its event (a split).
+    pub split: usize,
+    /// Overlaps a gesture, but names another action.
+    pub wrong: usize,
+    /// Overlaps no gesture (in a pause between them).
+    pub spurious: usize,
+}
+
+/// Why a sequence event matched no label.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExtraKind {
+    /// A second piece of a gesture whose label already has its event.
+    Split,
+    /// The wrong action over a gesture.
+    Wrong,
+    /// Over no gesture.
+    Spurious,
+}
+
+impl ExtraKind {
+    /// Classifies an unmatched event `e` against the sequence's labels.
+    pub fn of(e: &Ev, labels: &[Label]) -> ExtraKind {
+        let mut under = labels
+            .iter()
+            .filter(|l| overlap(e.start, e.end, l.start, l.end) > 0.0)
+            .peekable();
+        if under.peek().is_none() {
+            ExtraKind::Spurious
+        } else if under.any(|l| l.action == e.action) {
+            ExtraKind::Split
+        } else {
+            ExtraKind::Wrong
+        }
+    }
+
+    /// How `eval --verbose` names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExtraKind::Split => "second piece",
+            ExtraKind::Wrong => "wrong action",
+            ExtraKind::Spurious => "between gestures",
+        }
+    }
+}
+
+impl ExtraEvents {
+    /// Counts one event of `kind`.
+    pub fn add(&mut self, kind: ExtraKind) {
+        match kind {
+            ExtraKind::Split => self.split += 1,
+            ExtraKind::Wrong => self.wrong += 1,
+            ExtraKind::Spurious => self.spurious += 1,
+        }
+    }
 }
 
 fn label_ok(l: &Label, ev: &Ev) -> (bool, bool) {
@@ -277,6 +339,26 @@ pub fn evaluate(
                 f.latencies.push(e.decided - l.end);
             }
         }
+        for (e, _) in evs.iter().zip(&used).filter(|(_, u)| !**u) {
+            let kind = ExtraKind::of(e, &d.labels);
+            f.extra.add(kind);
+            if args.verbose {
+                let under: Vec<String> = d
+                    .labels
+                    .iter()
+                    .filter(|l| overlap(e.start, e.end, l.start, l.end) > 0.0)
+                    .map(|l| format!("{} {:.2}-{:.2}", l.action, l.start, l.end))
+                    .collect();
+                eprintln!(
+                    "  sequence {k}: extra event ({}) {} {:.2}-{:.2} over [{}]",
+                    kind.name(),
+                    e.action,
+                    e.start,
+                    e.end,
+                    under.join(", ")
+                );
+            }
+        }
     }
     let p = matched as f64 / n_ev.max(1) as f64;
     let r = matched as f64 / n_lab.max(1) as f64;
@@ -370,6 +452,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         100.0 * f.seq_prf.1,
         100.0 * f.seq_prf.2
     );
+    println!(
+        "  events matching no gesture: {} second pieces of a gesture, {} wrong action, {} \
+         between gestures",
+        f.extra.split, f.extra.wrong, f.extra.spurious
+    );
     let (med, p90) = quantiles(&f.latencies);
     println!(
         "Decision latency after the gesture ends: median {:.0} ms, 90th percentile {:.0} ms",
@@ -377,4 +464,64 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         1000.0 * p90
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn label(action: &str, start: f64, end: f64) -> Label {
+        Label {
+            action: action.into(),
+            start,
+            end,
+            time_class: TimeClass::Sudden,
+            weight_class: WeightClass::Strong,
+        }
+    }
+
+    fn ev(action: &str, start: f64, end: f64) -> Ev {
+        Ev {
+            action: action.into(),
+            start,
+            end,
+            decided: end,
+            time: 0.0,
+            weight: 0.0,
+        }
+    }
+
+    #[test]
+    fn unmatched_events_are_told_apart() {
+        let labels = [label("run", 1.0, 3.0), label("jump", 4.0, 5.0)];
+        assert_eq!(
+            ExtraKind::of(&ev("run", 2.2, 2.9), &labels),
+            ExtraKind::Split
+        );
+        assert_eq!(
+            ExtraKind::of(&ev("punch", 4.5, 4.8), &labels),
+            ExtraKind::Wrong
+        );
+        // Over the end of the run and the start of the jump: it is a piece of the run.
+        assert_eq!(
+            ExtraKind::of(&ev("run", 2.5, 4.2), &labels),
+            ExtraKind::Split
+        );
+        assert_eq!(
+            ExtraKind::of(&ev("jump", 3.2, 3.8), &labels),
+            ExtraKind::Spurious
+        );
+        let mut n = ExtraEvents::default();
+        for k in [ExtraKind::Split, ExtraKind::Split, ExtraKind::Spurious] {
+            n.add(k);
+        }
+        assert_eq!(
+            n,
+            ExtraEvents {
+                split: 2,
+                wrong: 0,
+                spurious: 1
+            }
+        );
+    }
 }
