@@ -8,7 +8,10 @@
 //!    otherwise *optional* (a transition or a wobble). The seed's "repeated more than twice"
 //!    counts samples; durations make the rule independent of the sample rate.
 //! 4. The mandatory strings of the examples are aligned to the average's by edit-distance
-//!    alignment. Column i becomes `(m_i0|…|m_in)+`, or `…*` when some example lacks it.
+//!    alignment. Column i becomes `(m_i0|…|m_in)+`, or `…*` when some example lacks it. A run
+//!    whose rotation barely turned (a wobble, [`intent_symbols`]) is written in a column as the
+//!    plain stroke or that wobble about the same axis (`f|f.Zn|f.Zp`), so a punch that rolls
+//!    does not accept a kick's pitch ([`expand_symbol`]).
 //! 5. The optional tokens found between two columns become `(o_1|…|o_k)*` before the later
 //!    column — or mandatory columns when every example has the same optional sequence there.
 //! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
@@ -89,6 +92,44 @@ pub const INCIDENTAL_ANGLE_RAD: f64 = 0.35;
 /// Share of the gesture's path length below which a run's translation half is incidental.
 pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
 
+/// Learner-only bits on an incidental-rotation wildcard (`f~`): the axes the wobble was seen
+/// about (bit 10 X, 11 Y, 12 Z). They never reach a library: [`expand_symbol`] writes such a
+/// symbol out as the plain token and its wobbles about that one axis (`f|f.Zp|f.Zn`), so a
+/// punch that rolls a little does not also accept a kick's deliberate pitch.
+pub const WOBBLE_AXES: Symbol = 0b111 << 10;
+
+/// The [`WOBBLE_AXES`] bits of the axes token `t` rotates about.
+fn wobble_axes(t: Token) -> Symbol {
+    let (_, a) = figurine_recognizer::token::token_signs(t & 0x3ff);
+    a.iter()
+        .enumerate()
+        .filter(|(_, s)| **s != 0)
+        .fold(0, |m, (i, _)| m | (1 << (10 + i)))
+}
+
+/// The symbols a learnt symbol stands for in a written pattern: a wildcard with wobble axes
+/// becomes the plain token plus both signs about its one axis (a wobble about two or three
+/// axes stays the full wildcard); every other symbol stands for itself.
+pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
+    let axes = s & WOBBLE_AXES;
+    if axes == 0 || s & ANY_ROT == 0 {
+        return vec![s & !WOBBLE_AXES];
+    }
+    if axes.count_ones() != 1 {
+        return vec![s & !WOBBLE_AXES];
+    }
+    let lin = (s & 0x3ff) / 27;
+    let axis = (axes >> 10).trailing_zeros() as usize;
+    let (l, _) = figurine_recognizer::token::token_signs(lin * 27 + NONE_BIN);
+    let mut out = vec![lin * 27 + NONE_BIN];
+    for sign in [-1i8, 1] {
+        let mut a = [0i8; 3];
+        a[axis] = sign;
+        out.push(figurine_recognizer::token::token_from_signs(l, a));
+    }
+    out
+}
+
 /// Like [`tokenize_gesture`], but each run is written as the symbol of what it means: a half
 /// that barely moved (a rotation of less than [`INCIDENTAL_ANGLE_RAD`], a translation shorter
 /// than [`INCIDENTAL_PATH_SHARE`] of the path) becomes a wildcard, so `d.Xp` with a 5° tilt is
@@ -110,7 +151,7 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
             let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
             let dist = dt * f64::from(r.acc.sum[18]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
-                (lin * 27 + NONE_BIN) | ANY_ROT
+                (lin * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
             } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
                 (NONE_BIN * 27 + ang) | ANY_LIN
             } else {
@@ -210,7 +251,17 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         }
     }
     out.extend(set.iter().filter(|t| !covered.contains(t)).copied());
-    out.into_iter().collect()
+    let full: BTreeSet<Symbol> = out
+        .iter()
+        .filter(|&&s| s & ANY_ROT != 0 && s & WOBBLE_AXES == 0)
+        .map(|&s| (s & 0x3ff) / 27)
+        .collect();
+    let expanded: BTreeSet<Symbol> = out.into_iter().flat_map(expand_symbol).collect();
+    // What a full wildcard of the same translation already accepts is not written again.
+    expanded
+        .into_iter()
+        .filter(|&s| s & ANY_ROT != 0 || s & ANY_LIN != 0 || !full.contains(&(s / 27)))
+        .collect()
 }
 
 fn merge_dups(v: Vec<Token>) -> Vec<Token> {
@@ -388,7 +439,13 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             opt_support.push(0);
             continue;
         }
-        let set: BTreeSet<Token> = per_seq.iter().flatten().copied().collect();
+        // Optional groups keep whole wildcards: they tell little apart, and the pattern's
+        // positions are better spent on its mandatory columns.
+        let set: BTreeSet<Token> = per_seq
+            .iter()
+            .flatten()
+            .map(|&t| t & !WOBBLE_AXES)
+            .collect();
         if set.is_empty() {
             opt.push(None);
             opt_support.push(0);
@@ -417,7 +474,8 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                 items.push(o.clone());
             }
             for &t in &inline[g] {
-                items.push(Regex::Plus(Box::new(Regex::Sym(t))));
+                let alt = Regex::Alt(expand_symbol(t).into_iter().map(Regex::Sym).collect());
+                items.push(Regex::Plus(Box::new(simplify(alt))));
             }
             if g < n {
                 let alt = simplify(Regex::Alt(
@@ -524,7 +582,8 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
 }
 
 fn mirror_seq(s: &Tokenized) -> Tokenized {
-    let flags = ANY_LIN | ANY_ROT;
+    // A mirror flips signs, not axes: the wobble axes stay.
+    let flags = ANY_LIN | ANY_ROT | WOBBLE_AXES;
     s.iter()
         .map(|&(t, d)| (mirror_token(t & !flags) | (t & flags), d))
         .collect()
@@ -737,6 +796,77 @@ mod tests {
         // (a punch's `b.Zn`).
         let n = names(&["b", "b.Xp"]);
         assert_eq!(n, ["b", "b.Xp"], "{n:?}");
+    }
+
+    /// `name` written as an incidental wobble (what [`intent_symbols`] makes of a run whose
+    /// rotation half barely turned): `f.Zp` → `f~` about Z.
+    fn wobble(name: &str) -> Symbol {
+        let t = parse_token(name).unwrap();
+        ((t / 27) * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
+    }
+
+    #[test]
+    fn a_wobble_is_written_as_the_plain_token_and_its_own_axis() {
+        let names = |s: Symbol| -> Vec<String> {
+            expand_symbol(s)
+                .into_iter()
+                .map(super::super::regex::symbol_name)
+                .collect()
+        };
+        assert_eq!(names(wobble("f.Zp")), ["f", "f.Zn", "f.Zp"]);
+        assert_eq!(names(wobble("db.Xn")), ["db", "db.Xn", "db.Xp"]);
+        // About two axes: no axis to keep, the whole wildcard.
+        assert_eq!(names(wobble("f.XpZn")), ["f~"]);
+        assert_eq!(names(parse_token("f.Xn").unwrap()), ["f.Xn"]);
+        // A mirror flips the wobble's sign, not its axis.
+        let m = mirror_seq(&vec![(wobble("lu.Zp"), 0.1)]);
+        assert_eq!(m[0].0, wobble("ru.Zp"));
+    }
+
+    #[test]
+    fn a_rolling_punch_does_not_accept_a_pitched_kick() {
+        // Three punches whose forward stroke rolls a little (incidental), once about each
+        // sign: the column accepts the plain stroke and any roll, not a pitch.
+        let punch = |w: Symbol| {
+            vec![
+                (parse_token("b").unwrap(), 0.2),
+                (w, 0.3),
+                (parse_token("b").unwrap(), 0.2),
+            ]
+        };
+        let seqs = vec![
+            punch(wobble("f.Zp")),
+            punch(wobble("f.Zn")),
+            punch(wobble("f.Zp")),
+            punch(wobble("f.Zn")),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        let toks = |s: &str| -> Vec<Token> {
+            s.split_whitespace()
+                .map(|w| parse_token(w).unwrap())
+                .collect()
+        };
+        for ok in ["b f b", "b f.Zp b", "b f.Zn b"] {
+            assert!(c.accepts(&toks(ok)), "{} rejects {ok}", re.to_source());
+        }
+        assert!(
+            !c.accepts(&toks("b f.Xn b")),
+            "{} accepts a kick",
+            re.to_source()
+        );
+        // Wobbles about two axes learn the whole wildcard, as before.
+        let seqs = vec![
+            punch(wobble("f.XpZp")),
+            punch(wobble("f.XnZn")),
+            punch(wobble("f.Zp")),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(
+            re.compile().unwrap().accepts(&toks("b f.Xn b")),
+            "{}",
+            re.to_source()
+        );
     }
 
     #[test]
