@@ -11,7 +11,9 @@
 //!    alignment. Column i becomes `(m_i0|…|m_in)+`, or `…*` when some example lacks it. A run
 //!    whose rotation barely turned (a wobble, [`intent_symbols`]) is written in a column as the
 //!    plain stroke or that wobble about the same axis (`f|f.Zn|f.Zp`), so a punch that rolls
-//!    does not accept a kick's pitch ([`expand_symbol`]).
+//!    does not accept a kick's pitch ([`expand_symbol`]). A pattern needs two tokens at
+//!    least: when its only mandatory column is a part every example performs twice or more
+//!    (a run's strides), that column is written twice.
 //! 5. The optional tokens found between two columns become `(o_1|…|o_k)*` before the later
 //!    column — or mandatory columns when every example has the same optional sequence there.
 //! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
@@ -467,6 +469,19 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         }
         optional_col[g] = false;
     }
+    // A pattern needs two tokens at least: one lone stroke (a kick's thrust) is no run. When
+    // the only mandatory part is one every example performs at least twice (a run's strides),
+    // it is written twice.
+    let mandatory: Vec<usize> = (0..n).filter(|&g| !optional_col[g]).collect();
+    let doubled = match (mandatory.as_slice(), inline.iter().all(Vec::is_empty)) {
+        ([g], true) => {
+            let k = key(ref_m[*g]);
+            seqs.iter()
+                .all(|s| s.iter().filter(|x| key(x.0) == k).count() >= 2)
+                .then_some(*g)
+        }
+        _ => None,
+    };
     loop {
         let mut items = Vec::new();
         for g in 0..=n {
@@ -483,6 +498,9 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                 ));
                 // Optional only when most sequences lack it: a part one performance skipped
                 // is still part of the gesture (that performance then costs an edit).
+                if doubled == Some(g) {
+                    items.push(alt.clone());
+                }
                 items.push(if optional_col[g] {
                     Regex::Star(Box::new(alt))
                 } else {
@@ -867,6 +885,26 @@ mod tests {
             "{}",
             re.to_source()
         );
+    }
+
+    #[test]
+    fn a_part_every_example_repeats_is_needed_twice() {
+        // Runs: every example has several forward strides; a lone forward thrust is no run.
+        let seqs = vec![
+            seq("f:0.3 f.Zp:0.1 f:0.3"),
+            seq("f:0.2 f:0.2 f:0.2 f:0.2"),
+            seq("f:0.3 uf:0.05 f:0.3"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        assert_eq!(c.min_len(), 2, "{}", re.to_source());
+        let f = parse_token("f").unwrap();
+        assert!(!c.accepts(&[f]), "{}", re.to_source());
+        assert!(c.accepts(&[f, f, f]), "{}", re.to_source());
+        // One example with a single stroke: one is enough.
+        let seqs = vec![seq("f:0.3 f.Zp:0.1 f:0.3"), seq("f:0.6")];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(re.compile().unwrap().accepts(&[f]), "{}", re.to_source());
     }
 
     #[test]
