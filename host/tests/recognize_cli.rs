@@ -224,3 +224,52 @@ fn malformed_logs_name_file_and_line() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn eval_over_seed_pairs_prints_each_pair_and_the_mean() {
+    let out = figurine(&[
+        "eval",
+        "--pairs",
+        "2",
+        "--isolated",
+        "2",
+        "--sequences",
+        "1",
+        "--effort-per-class",
+        "4",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Pair k trains with seed 1 + (k − 1) and tests on 1000 + 1000·(k − 1).
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .filter(|w| w.iter().any(|x| x.ends_with('%')) && !w.contains(&"range:"))
+        .collect();
+    assert_eq!(rows.len(), 3, "{text}");
+    assert_eq!(&rows[0][..3], ["1", "1", "1000"], "{text}");
+    assert_eq!(&rows[1][..3], ["2", "2", "2000"], "{text}");
+    let pct = |w: &str| -> f64 { w.trim_end_matches('%').parse().unwrap() };
+    for (row, first) in rows.iter().zip([3, 3, 1]) {
+        for w in &row[first..first + 5] {
+            assert!((0.0..=100.0).contains(&pct(w)), "{w} in {text}");
+        }
+    }
+    // The mean of the two isolated figures.
+    let mean = (pct(rows[0][3]) + pct(rows[1][3])) / 2.0;
+    assert!((pct(rows[2][1]) - mean).abs() < 0.06, "{text}");
+    assert!(text.contains("range: isolated"), "{text}");
+
+    // Pairs learn anew: a given library is refused, with the reason.
+    let out = figurine(&["eval", "--pairs", "2", "--library", "lib.json"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--pairs") && err.contains("--library"),
+        "{err}"
+    );
+}

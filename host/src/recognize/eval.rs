@@ -18,7 +18,6 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
-use super::effort_model::EffortFile;
 use super::effort_train::{gesture_features, train, Example, Trained};
 use super::feed::{log_samples, recognize_log, Clock};
 use super::learn::learn_action;
@@ -67,6 +66,11 @@ pub struct EvalArgs {
     /// event that matched no gesture (with why).
     #[arg(long)]
     pub verbose: bool,
+    /// Repeat the evaluation over this many independent seed pairs: pair i learns and trains
+    /// with `--train-seed` + i and tests on `--seed` + 1000·i; prints a line per pair and
+    /// the mean (with learning and training only, not with given files).
+    #[arg(long, default_value_t = 1)]
+    pub pairs: usize,
 }
 
 /// Learns every synth action from `n` generated examples.
@@ -384,9 +388,9 @@ pub fn quantiles(v: &[f64]) -> (f64, f64) {
     (s[s.len() / 2], s[(s.len() * 9 / 10).min(s.len() - 1)])
 }
 
-/// `figurine eval`.
-pub fn run(args: &EvalArgs) -> Result<()> {
-    let knobs = Knobs::default();
+/// The library and effort model `eval` measures: given files, or learnt and trained from
+/// `--train-seed` (saved where `--save-library` / `--save-effort` say).
+pub fn prepare(args: &EvalArgs, knobs: &Knobs) -> Result<(LibraryFile, EffortModel)> {
     let mut lib = match &args.library {
         Some(p) => LibraryFile::read(p)?,
         None => {
@@ -396,7 +400,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
                 args.examples,
                 args.train_seed
             );
-            learn_synth_library(args.train_seed, args.examples, &knobs)?
+            learn_synth_library(args.train_seed, args.examples, knobs)?
         }
     };
     if let Some(p) = &args.save_library {
@@ -409,14 +413,23 @@ pub fn run(args: &EvalArgs) -> Result<()> {
                 "training effort on {} gestures per state (seed {})…",
                 args.effort_per_class, args.train_seed
             );
-            let (_, t) = train_synth_effort(args.train_seed, args.effort_per_class, &knobs)?;
+            let (_, t) = train_synth_effort(args.train_seed, args.effort_per_class, knobs)?;
             if let Some(p) = &args.save_effort {
                 t.file.write(p)?;
             }
             t.file.model()?
         }
     };
-    let _ = EffortFile::default_model;
+    Ok((lib, effort))
+}
+
+/// `figurine eval`.
+pub fn run(args: &EvalArgs) -> Result<()> {
+    if args.pairs > 1 {
+        return super::eval_pairs::run(args);
+    }
+    let knobs = Knobs::default();
+    let (mut lib, effort) = prepare(args, &knobs)?;
     let f = evaluate(args, &mut lib, effort, &knobs)?;
     println!(
         "Isolated gestures (seed {}), {} per action:",

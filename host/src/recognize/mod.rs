@@ -7,11 +7,13 @@
 //! - [`dtw`] + [`learn`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ [`font`]): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
+//! - [`eval`] (+ [`eval_pairs`]): `figurine eval`.
 
 pub mod dtw;
 pub mod effort_model;
 pub mod effort_train;
 pub mod eval;
+pub mod eval_pairs;
 pub mod feed;
 pub mod learn;
 pub mod library;

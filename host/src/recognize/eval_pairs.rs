@@ -1,0 +1,181 @@
+//! `figurine eval --pairs K`: the whole evaluation over K independent (train, test) seed
+//! pairs, so a change in the recognizer or the learner is judged on more than one draw of
+//! the generator. One evaluation is a few hundred generated gestures; which performances a
+//! draw happens to contain moves its figures by several points, more than many changes do.
+
+use anyhow::{bail, Result};
+
+use super::eval::{evaluate, prepare, quantiles, EvalArgs, Figures};
+use crate::synth::Knobs;
+
+/// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
+pub const TEST_SEED_STEP: u64 = 1000;
+
+/// The figures of one pair, as printed: isolated, F1, Time, Weight, state (shares), median
+/// latency (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairLine {
+    /// Isolated-gesture accuracy.
+    pub isolated: f64,
+    /// Sequence F1.
+    pub f1: f64,
+    /// Time accuracy.
+    pub time: f64,
+    /// Weight accuracy.
+    pub weight: f64,
+    /// State accuracy.
+    pub state: f64,
+    /// Median decision latency, seconds.
+    pub latency_s: f64,
+}
+
+impl PairLine {
+    /// The summary of one evaluation.
+    pub fn of(f: &Figures) -> PairLine {
+        PairLine {
+            isolated: f.isolated,
+            f1: f.seq_prf.2,
+            time: f.time,
+            weight: f.weight,
+            state: f.state,
+            latency_s: quantiles(&f.latencies).0,
+        }
+    }
+
+    fn fields(&self) -> [f64; 6] {
+        [
+            100.0 * self.isolated,
+            100.0 * self.f1,
+            100.0 * self.time,
+            100.0 * self.weight,
+            100.0 * self.state,
+            1000.0 * self.latency_s,
+        ]
+    }
+}
+
+/// Per field: mean, smallest, largest over `lines` (percent, latency in ms).
+pub fn summarise(lines: &[PairLine]) -> [(f64, f64, f64); 6] {
+    let mut out = [(0.0, f64::INFINITY, f64::NEG_INFINITY); 6];
+    for l in lines {
+        for (o, v) in out.iter_mut().zip(l.fields()) {
+            o.0 += v / lines.len() as f64;
+            o.1 = o.1.min(v);
+            o.2 = o.2.max(v);
+        }
+    }
+    out
+}
+
+fn header() {
+    println!(
+        "{:>5} {:>6} {:>6}  {:>8} {:>6} {:>6} {:>6} {:>6} {:>8}",
+        "pair", "train", "test", "isolated", "F1", "Time", "Weight", "state", "latency"
+    );
+}
+
+/// `figurine eval --pairs K`.
+pub fn run(args: &EvalArgs) -> Result<()> {
+    if args.library.is_some()
+        || args.effort.is_some()
+        || args.save_library.is_some()
+        || args.save_effort.is_some()
+    {
+        bail!(
+            "--pairs learns and trains anew for every pair; it does not take --library, \
+             --effort, --save-library or --save-effort"
+        );
+    }
+    let knobs = Knobs::default();
+    let mut lines = Vec::new();
+    let mut rows = Vec::new();
+    for i in 0..args.pairs as u64 {
+        let pair = EvalArgs {
+            seed: args.seed.wrapping_add(TEST_SEED_STEP.wrapping_mul(i)),
+            train_seed: args.train_seed.wrapping_add(i),
+            pairs: 1,
+            library: None,
+            effort: None,
+            save_library: None,
+            save_effort: None,
+            ..*args
+        };
+        let (mut lib, effort) = prepare(&pair, &knobs)?;
+        let line = PairLine::of(&evaluate(&pair, &mut lib, effort, &knobs)?);
+        rows.push((pair.train_seed, pair.seed));
+        lines.push(line);
+    }
+    println!(
+        "{} seed pairs, {} isolated gestures per action and {} sequences each:",
+        args.pairs, args.isolated, args.sequences
+    );
+    header();
+    for (k, ((train, test), l)) in rows.iter().zip(&lines).enumerate() {
+        let v = l.fields();
+        println!(
+            "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms",
+            k + 1,
+            train,
+            test,
+            v[0],
+            v[1],
+            v[2],
+            v[3],
+            v[4],
+            v[5]
+        );
+    }
+    let s = summarise(&lines);
+    println!(
+        "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms",
+        "mean", "", "", s[0].0, s[1].0, s[2].0, s[3].0, s[4].0, s[5].0
+    );
+    println!(
+        "range: isolated {:.1}–{:.1}%, F1 {:.1}–{:.1}%, Time {:.1}–{:.1}%, Weight {:.1}–{:.1}%, \
+         state {:.1}–{:.1}%, latency {:.0}–{:.0} ms",
+        s[0].1,
+        s[0].2,
+        s[1].1,
+        s[1].2,
+        s[2].1,
+        s[2].2,
+        s[3].1,
+        s[3].2,
+        s[4].1,
+        s[4].2,
+        s[5].1,
+        s[5].2
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_summary_is_the_mean_and_range_of_each_figure() {
+        let a = PairLine {
+            isolated: 0.8,
+            f1: 0.7,
+            time: 0.9,
+            weight: 0.85,
+            state: 0.75,
+            latency_s: 0.140,
+        };
+        let b = PairLine {
+            isolated: 0.9,
+            f1: 0.8,
+            time: 0.8,
+            weight: 0.95,
+            state: 0.85,
+            latency_s: 0.160,
+        };
+        let s = summarise(&[a, b]);
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-9;
+        assert!(close(s[0].0, 85.0) && close(s[0].1, 80.0) && close(s[0].2, 90.0));
+        assert!(close(s[1].0, 75.0));
+        assert!(close(s[2].1, 80.0) && close(s[2].2, 90.0));
+        assert!(close(s[5].0, 150.0) && close(s[5].1, 140.0) && close(s[5].2, 160.0));
+    }
+}
