@@ -425,6 +425,9 @@ pub fn prepare(args: &EvalArgs, knobs: &Knobs) -> Result<(LibraryFile, EffortMod
 
 /// `figurine eval`.
 pub fn run(args: &EvalArgs) -> Result<()> {
+    if args.pairs == 0 {
+        anyhow::bail!("--pairs must be at least 1");
+    }
     if args.pairs > 1 {
         return super::eval_pairs::run(args);
     }

@@ -114,10 +114,7 @@ fn wobble_axes(t: Token) -> Symbol {
 /// axes stays the full wildcard); every other symbol stands for itself.
 pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
     let axes = s & WOBBLE_AXES;
-    if axes == 0 || s & ANY_ROT == 0 {
-        return vec![s & !WOBBLE_AXES];
-    }
-    if axes.count_ones() != 1 {
+    if axes.count_ones() != 1 || s & ANY_ROT == 0 {
         return vec![s & !WOBBLE_AXES];
     }
     let lin = (s & 0x3ff) / 27;
@@ -496,11 +493,11 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                 let alt = simplify(Regex::Alt(
                     generalise(&cols[g]).into_iter().map(Regex::Sym).collect(),
                 ));
-                // Optional only when most sequences lack it: a part one performance skipped
-                // is still part of the gesture (that performance then costs an edit).
                 if doubled == Some(g) {
                     items.push(alt.clone());
                 }
+                // Optional only when most sequences lack it: a part one performance skipped
+                // is still part of the gesture (that performance then costs an edit).
                 items.push(if optional_col[g] {
                     Regex::Star(Box::new(alt))
                 } else {
