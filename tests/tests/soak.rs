@@ -49,6 +49,50 @@ fn env_u64(name: &str, default: u64) -> u64 {
 /// `GetStats` (it answers after every pose sent before it has been processed).
 const DRAIN_TIMEOUT_S: u64 = 120;
 
+/// Keeps every host core busy at the lowest priority while the stream runs (one
+/// `nice -n 19` spinning shell per core), and stops them when dropped.
+///
+/// Why: QEMU hands each received byte from its I/O thread to its CPU thread (the emulated UART
+/// holds one byte), ≈ 50 000 thread wake-ups a second at 1 kHz. On a virtual machine whose
+/// cores are idle, each wake-up first has to bring a sleeping core back (a hypervisor exit),
+/// and the emulator then moved only ≈ 700 poses/s: the device's lag grew by ≈ 3 s every 10 s.
+/// With the cores kept awake by work of the lowest priority, which yields to QEMU and the
+/// sender at once, the same run caught up (see RELIABILITY.md). Set
+/// `FIGURINE_SOAK_KEEP_AWAKE=0` to measure without it.
+struct KeepAwake(Vec<std::process::Child>);
+
+impl KeepAwake {
+    fn start() -> KeepAwake {
+        if std::env::var("FIGURINE_SOAK_KEEP_AWAKE").is_ok_and(|v| v.trim() == "0") {
+            return KeepAwake(Vec::new());
+        }
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let spinners = (0..cores)
+            .filter_map(|_| {
+                std::process::Command::new("nice")
+                    .args(["-n", "19", "sh", "-c", "while :; do :; done"])
+                    .stdin(std::process::Stdio::null())
+                    .spawn()
+                    .ok()
+            })
+            .collect::<Vec<_>>();
+        println!(
+            "soak: {} lowest-priority spinners keep the host cores awake",
+            spinners.len()
+        );
+        KeepAwake(spinners)
+    }
+}
+
+impl Drop for KeepAwake {
+    fn drop(&mut self) {
+        for c in &mut self.0 {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
 /// What the device has reported so far.
 #[derive(Default)]
 struct Progress {
@@ -140,6 +184,7 @@ fn soak_1khz_pose_stream() {
         blobs.names.len()
     );
 
+    let _awake = KeepAwake::start();
     let start = Instant::now();
     let mut worst_late = Duration::ZERO;
     let mut cursor = 0usize;
