@@ -27,7 +27,8 @@ use clap::Args;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::token::{
-    mirror_token, symbol_matches, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL, TURN,
+    mirror_token, symbol_matches, token_from_signs, token_signs, Symbol, Token, ANY_LIN, ANY_ROT,
+    NONE_BIN, STILL, TURN,
 };
 use figurine_recognizer::Library;
 
@@ -98,15 +99,17 @@ pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
 /// about (bit 10 X, 11 Y, 12 Z). They never reach a library: [`expand_symbol`] writes such a
 /// symbol out as the plain token and its wobbles about that one axis (`f|f.Zp|f.Zn`), so a
 /// punch that rolls a little does not also accept a kick's deliberate pitch.
-pub const WOBBLE_AXES: Symbol = 0b111 << 10;
+pub const WOBBLE_AXES: Symbol = 0b111 << WOBBLE_SHIFT;
+/// Bit of the X axis in [`WOBBLE_AXES`] (Y and Z follow).
+const WOBBLE_SHIFT: u16 = 10;
 
 /// The [`WOBBLE_AXES`] bits of the axes token `t` rotates about.
 fn wobble_axes(t: Token) -> Symbol {
-    let (_, a) = figurine_recognizer::token::token_signs(t & 0x3ff);
+    let (_, a) = token_signs(t & 0x3ff);
     a.iter()
         .enumerate()
         .filter(|(_, s)| **s != 0)
-        .fold(0, |m, (i, _)| m | (1 << (10 + i)))
+        .fold(0, |m, (i, _)| m | (1 << (WOBBLE_SHIFT as usize + i)))
 }
 
 /// The symbols a learnt symbol stands for in a written pattern: a wildcard with wobble axes
@@ -118,13 +121,13 @@ pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
         return vec![s & !WOBBLE_AXES];
     }
     let lin = (s & 0x3ff) / 27;
-    let axis = (axes >> 10).trailing_zeros() as usize;
-    let (l, _) = figurine_recognizer::token::token_signs(lin * 27 + NONE_BIN);
+    let axis = (axes >> WOBBLE_SHIFT).trailing_zeros() as usize;
+    let (l, _) = token_signs(lin * 27 + NONE_BIN);
     let mut out = vec![lin * 27 + NONE_BIN];
     for sign in [-1i8, 1] {
         let mut a = [0i8; 3];
         a[axis] = sign;
-        out.push(figurine_recognizer::token::token_from_signs(l, a));
+        out.push(token_from_signs(l, a));
     }
     out
 }
