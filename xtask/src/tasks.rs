@@ -52,6 +52,8 @@ pub fn firmware(board: Board, release: bool) -> Result<()> {
         "--no-default-features",
         "--features",
         board.feature(),
+        "--target-dir",
+        board.target_dir(),
     ]);
     if release {
         cmd.arg("--release");
