@@ -4,6 +4,12 @@
 //! `{"action":"jump","start":1.23,"end":2.01,"time":0.62,"weight":-0.31,"distance":1}`.
 //! This is the boundary between recognition and animation: `animate --events` reads it, the
 //! renderer draws it as a timeline, the device link prints it.
+//!
+//! Streams printed while a figurine plays (`figurine live`, `figurine replay`) may also hold
+//! continuation lines, the same object plus `"continues":true`: the previous action went on
+//! (a walk's next hops after a short pause) and this line, with the same start and a later
+//! end, replaces it. [`read_events`] folds them, so such a stream reads as one object per
+//! action, like `simulate`'s.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -62,7 +68,7 @@ pub fn read_events_path(path: &Path) -> Result<Vec<ActionRecord>, EventsError> {
 
 /// Reads JSON-lines events from any reader; `name` is used in error messages.
 pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>, EventsError> {
-    let mut out = Vec::new();
+    let mut out: Vec<ActionRecord> = Vec::new();
     for (i, line) in BufReader::new(reader).lines().enumerate() {
         let line = line.map_err(|e| EventsError::Malformed {
             path: name.to_path_buf(),
@@ -72,7 +78,7 @@ pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>,
         if line.trim().is_empty() {
             continue;
         }
-        let rec: ActionRecord =
+        let Line { rec, continues } =
             serde_json::from_str(&line).map_err(|e| EventsError::Malformed {
                 path: name.to_path_buf(),
                 line: i + 1,
@@ -85,9 +91,21 @@ pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>,
                 reason: format!("bad segment times start={} end={}", rec.start, rec.end),
             });
         }
-        out.push(rec);
+        match out.last_mut() {
+            Some(last) if continues && last.action == rec.action => *last = rec,
+            _ => out.push(rec),
+        }
     }
     Ok(out)
+}
+
+/// One line of an event stream: an action, possibly continuing the previous one.
+#[derive(Deserialize)]
+struct Line {
+    #[serde(flatten)]
+    rec: ActionRecord,
+    #[serde(default)]
+    continues: bool,
 }
 
 /// Writes one event as a JSON line.
@@ -96,9 +114,52 @@ pub fn write_event<W: Write>(mut w: W, rec: &ActionRecord) -> std::io::Result<()
     writeln!(w, "{line}")
 }
 
+/// The JSON line of an action update: `rec` itself when it is a new action, `rec` plus
+/// `"continues":true` when it continues (and replaces) the previous line's action.
+pub fn event_line(rec: &ActionRecord, continues: bool) -> String {
+    let mut line = serde_json::to_string(rec).unwrap_or_default();
+    if continues && line.ends_with('}') {
+        line.pop();
+        line.push_str(",\"continues\":true}");
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_continuation_line_replaces_the_action_it_continues() {
+        let walk = ActionRecord {
+            action: "walk".into(),
+            start: 1.0,
+            end: 2.0,
+            time: 0.1,
+            weight: -0.2,
+            distance: 0,
+        };
+        let longer = ActionRecord {
+            end: 3.5,
+            distance: 1,
+            ..walk.clone()
+        };
+        let jump = ActionRecord {
+            action: "jump".into(),
+            start: 4.0,
+            end: 4.6,
+            ..walk.clone()
+        };
+        let text = [
+            event_line(&walk, false),
+            event_line(&longer, true),
+            event_line(&jump, false),
+        ]
+        .join("\n");
+        assert!(text.contains(r#""distance":1,"continues":true}"#), "{text}");
+        let got = read_events(text.as_bytes(), Path::new("stream.jsonl")).unwrap();
+        assert_eq!(got, [longer, jump]);
+    }
 
     #[test]
     fn reads_the_contract_line_and_round_trips() {

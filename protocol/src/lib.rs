@@ -38,7 +38,7 @@ pub use message::*;
 pub use pose::Pose;
 
 /// Version of this wire protocol; both `Hello`s carry it and peers must match exactly.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 
 /// Checks a peer's `Hello` against ours.
 pub fn check_version(peer: u16) -> Result<(), ProtocolError> {

@@ -66,7 +66,8 @@ pub struct DeviceHello {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ActionEvent {
-    /// Event counter, +1 per event, wrapping; a gap means an event was lost.
+    /// Event counter, +1 per event, wrapping; a gap means an event was lost. A
+    /// [`DeviceToHost::Continued`] repeats the counter of the event it continues.
     pub seq: u8,
     /// Index of the action in the uploaded library.
     pub action: u8,
@@ -235,6 +236,11 @@ pub enum DeviceToHost {
     Error(DeviceError),
     /// Answer to `Ping`, echoing its value.
     Pong(u32),
+    /// The previous `Event` (same `seq`) goes on: the next cycle of a cyclic action (a walk's
+    /// next hops after a short pause) extended it. It carries the whole segment, with effort
+    /// and distance over all of it, and replaces that event — it is not a new action. Sent
+    /// only right after the event it continues (or after another continuation of it).
+    Continued(ActionEvent),
 }
 
 /// Reads the protocol version from a `Hello` payload of *any* version (variant 0 with the

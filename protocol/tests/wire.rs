@@ -71,6 +71,18 @@ fn samples() -> Vec<(&'static str, Vec<u8>)> {
             })),
         ),
         (
+            "continued",
+            d(DeviceToHost::Continued(ActionEvent {
+                seq: 9,
+                action: 3,
+                end_seq: 40_100,
+                len: 175,
+                time: 75,
+                weight: -41,
+                distance: 2,
+            })),
+        ),
+        (
             "upload_ack",
             d(DeviceToHost::UploadAck {
                 kind: BlobKind::Library,

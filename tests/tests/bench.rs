@@ -117,7 +117,7 @@ fn figure_instructions_per_sample() {
             &log,
             &blobs.names,
             ReplayOptions::default(),
-            |_| {},
+            |_, _| {},
         )
         .expect("replay");
         drop(dev);
@@ -169,7 +169,7 @@ fn figure_latency_and_sustained_rate() {
             speed: Some(1.0),
             ..ReplayOptions::default()
         },
-        |_| {},
+        |_, _| {},
     )
     .expect("real-time replay");
     let mut lat: Vec<f64> = r
@@ -211,7 +211,7 @@ fn figure_latency_and_sustained_rate() {
             speed: Some(speed),
             flow_control: false,
         };
-        let r = match replay_log(&mut dev, &log, &blobs.names, opts, |_| {}) {
+        let r = match replay_log(&mut dev, &log, &blobs.names, opts, |_, _| {}) {
             Ok(r) => r,
             Err(e) => {
                 println!("  {rate:>8.0} poses/s: link saturated ({e})");

@@ -67,8 +67,14 @@ fn cut_case(after_bytes: u32, check_events: bool) {
         let log = sequence(11, &Knobs::default(), 4, None).log;
         let effort = EffortModel::from_bytes(&old.effort).expect("effort");
         let sim = simulate_log(&log, &old.names, &old.library, Some(effort)).expect("simulate");
-        let got = replay_log(&mut dev, &log, &old.names, ReplayOptions::default(), |_| {})
-            .expect("replay");
+        let got = replay_log(
+            &mut dev,
+            &log,
+            &old.names,
+            ReplayOptions::default(),
+            |_, _| {},
+        )
+        .expect("replay");
         assert_eq!(got.records, sim.records);
     }
 

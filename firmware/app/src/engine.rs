@@ -123,8 +123,14 @@ impl Engine {
 
     async fn emit(&mut self, e: figurine_recognizer::ActionEvent) {
         let len = e.end_seq.wrapping_sub(e.start_seq).min(u32::from(u16::MAX)) as u16;
+        // A continuation repeats the counter of the event it extends.
+        let seq = if e.continues {
+            self.event_seq.wrapping_sub(1)
+        } else {
+            self.event_seq
+        };
         let msg = ActionEvent {
-            seq: self.event_seq,
+            seq,
             action: e.action,
             end_seq: e.end_seq as u16,
             len,
@@ -132,10 +138,14 @@ impl Engine {
             weight: e.weight_q,
             distance: e.distance,
         };
-        self.event_seq = self.event_seq.wrapping_add(1);
-        defmt::info!("event {}", msg);
+        defmt::info!("event {} (continues: {})", msg, e.continues);
         stats::update(|s| s.events = s.events.wrapping_add(1));
-        send_to_host(DeviceToHost::Event(msg)).await;
+        if e.continues {
+            send_to_host(DeviceToHost::Continued(msg)).await;
+        } else {
+            self.event_seq = self.event_seq.wrapping_add(1);
+            send_to_host(DeviceToHost::Event(msg)).await;
+        }
     }
 
     /// Ends the current session: emits any action still waiting for its look-ahead, then

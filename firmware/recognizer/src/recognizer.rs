@@ -3,7 +3,7 @@
 //! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1 KiB,
-//! effort model 0.6 KiB, a held cyclic event 0.2 KiB — 13.0 KiB in all (13,344 B by `size_of`,
+//! effort model 0.6 KiB, the last cyclic event (open to continuation) 0.2 KiB — 13.0 KiB in all (13,344 B by `size_of`,
 //! measured by a test) with 32 actions loaded.
 
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
@@ -14,8 +14,8 @@ use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, Candidate, Decider, Decision, CYCLIC_PAUSE_US, HOLD_BACK_TOKENS, HOLD_US,
-    LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
+    edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, HOLD_BACK_TOKENS,
+    HOLD_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -48,6 +48,10 @@ pub struct ActionEvent {
     pub decided_seq: u32,
     /// Time of that sample, µs (decision latency = this − `end_us`).
     pub decided_us: u64,
+    /// This event continues the previous one (same action, its `start`, a later `end`, effort
+    /// and distance over both): the next cycle of a walk after a short pause. A consumer
+    /// replaces the previous event with it instead of adding a new one.
+    pub continues: bool,
 }
 
 /// Running statistics.
@@ -63,7 +67,7 @@ pub struct Stats {
     pub events: u32,
 }
 
-/// A committed cyclic action not yet emitted: the next hop of a walk may still join it.
+/// The last emitted event of a cyclic action, while the next cycle may still continue it.
 #[derive(Debug, Clone, Copy)]
 struct Held {
     action: u8,
@@ -193,15 +197,15 @@ impl<'lib> Recognizer<'lib> {
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
                 }
-                if still >= CYCLIC_PAUSE_US {
-                    self.release(&mut emit);
+                if still >= CONTINUE_US {
+                    self.held = None;
                 }
             }
         }
-        // A held cyclic action is released once the figurine has clearly moved on.
+        // Nor once the figurine has clearly moved on.
         if let (Some(h), Some(n)) = (self.held, newest) {
             if n.wrapping_sub(h.end_run) > 2 * u32::from(LOOKAHEAD_TOKENS) {
-                self.release(&mut emit);
+                self.held = None;
             }
         }
     }
@@ -256,8 +260,7 @@ impl<'lib> Recognizer<'lib> {
             || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
-    fn release(&mut self, emit: &mut impl FnMut(ActionEvent)) {
-        let Some(h) = self.held.take() else { return };
+    fn emit_held(&mut self, h: Held, continues: bool, emit: &mut impl FnMut(ActionEvent)) {
         let (lt, lw) = match &self.effort {
             Some(m) => m.classify(&segment_features(&h.acc)),
             None => (0.0, 0.0),
@@ -273,6 +276,7 @@ impl<'lib> Recognizer<'lib> {
             distance: h.distance,
             decided_seq: self.now_seq,
             decided_us: self.now_us,
+            continues,
         });
         self.events = self.events.saturating_add(1);
     }
@@ -282,7 +286,7 @@ impl<'lib> Recognizer<'lib> {
         if let Some(c) = self.decider.pending() {
             self.commit(c, &mut emit);
         }
-        self.release(&mut emit);
+        self.held = None;
     }
 
     /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.
@@ -404,18 +408,19 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         let acc = hist.accum(from, to);
-        // Only STILL runs between the held action and this one?
+        // Nothing but stillness and a few unmatched strokes (the edges of the cycles) between
+        // the held event and this one?
         let contiguous = self.held.is_some_and(|h| {
             let mut i = h.end_run.wrapping_add(1);
-            let mut ok = true;
+            let mut moving = 0usize;
             for _ in 0..HISTORY_RUNS {
                 if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
                     break;
                 }
-                ok &= hist.get(i).is_some_and(|r| r.token == STILL);
+                moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
                 i = i.wrapping_add(1);
             }
-            ok
+            moving <= CONTINUE_GAP_RUNS
         });
         self.bank.reset();
         self.decider.clear();
@@ -428,27 +433,25 @@ impl<'lib> Recognizer<'lib> {
             // gesture is this brief. Its runs are consumed; nothing is emitted.
             return;
         }
-        match &mut self.held {
-            Some(h) if h.action == c.action && contiguous => {
-                h.end = end;
-                h.end_run = c.end;
-                h.distance = h.distance.max(c.distance);
-                h.acc.merge(&acc);
-                return;
-            }
-            _ => self.release(emit),
+        if let Some(mut h) = self.held.filter(|h| h.action == c.action && contiguous) {
+            h.end = end;
+            h.end_run = c.end;
+            h.distance = h.distance.max(c.distance);
+            h.acc.merge(&acc);
+            self.held = Some(h);
+            self.emit_held(h, true, emit);
+            return;
         }
-        self.held = Some(Held {
+        let h = Held {
             action: c.action,
             start,
             end,
             end_run: c.end,
             distance: c.distance,
             acc,
-        });
-        if !c.cyclic {
-            self.release(emit);
-        }
+        };
+        self.held = c.cyclic.then_some(h);
+        self.emit_held(h, false, emit);
     }
 }
 
@@ -528,6 +531,94 @@ mod tests {
             [1],
             "{ev:?}"
         );
+    }
+
+    /// `hops` hops forward (as [`hops`]), each pair of hops separated by `pause_s` of stillness.
+    fn paused_hops(hops: usize, pause_s: f32) -> Vec<Sample> {
+        let rate = 120.0f32;
+        let (still, hop) = (0.6f32, 0.5f32);
+        let period = hop + pause_s;
+        let total = 2.0 * still + hops as f32 * period;
+        let n = (total * rate) as u32;
+        (0..n)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let (mut y, mut z) = (0.0f32, 0.0f32);
+                if t > still {
+                    let k = libm::floorf((t - still) / period);
+                    let within = ((t - still) - k * period) / hop;
+                    let done = k.min(hops as f32) + within.min(1.0);
+                    z = 0.2 * done.min(hops as f32);
+                    if (k as usize) < hops && within < 1.0 {
+                        y = 0.1 * libm::sinf(core::f32::consts::PI * within);
+                    }
+                }
+                Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, 1.0 + y, z],
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    /// A one-hop pattern `uf+ f* df+`, cyclic (the whole may repeat) or not.
+    fn hop_library(cyclic: bool) -> Vec<u8> {
+        let syms: Vec<Token> = ["uf", "f", "df"]
+            .iter()
+            .map(|t| crate::token::parse_token(t).unwrap())
+            .collect();
+        let mut follow = [1 << 1, 0b110, 0b1100, 0b1000];
+        if cyclic {
+            follow[3] |= 1 << 1;
+        }
+        let mut blob = Vec::from(*b"FGL\x01");
+        blob.extend([1, 0, 0, 0]);
+        crate::pattern::encode_record(&mut blob, &syms, &follow, 1 << 3, 0, cyclic).unwrap();
+        blob
+    }
+
+    #[test]
+    fn the_next_cycle_after_a_short_pause_continues_the_event() {
+        let blob = hop_library(true);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // 350 ms between hops: longer than the stillness that commits a cycle
+        // (`CYCLIC_PAUSE_US`), shorter than the one that ends the action (`CONTINUE_US`).
+        let ev = run(&lib, &paused_hops(3, 0.35));
+        assert_eq!(
+            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            [false, true, true],
+            "{ev:?}"
+        );
+        // Each continuation keeps the start, reaches further, and is decided later.
+        for w in ev.windows(2) {
+            assert_eq!(w[1].start_us, w[0].start_us);
+            assert!(w[1].end_us > w[0].end_us + 500_000);
+            assert!(w[1].decided_us > w[0].decided_us);
+        }
+        // The first cycle is reported without waiting for the others.
+        assert!(ev[0].decided_us < ev[1].end_us);
+    }
+
+    #[test]
+    fn a_long_pause_or_a_one_shot_action_starts_a_new_event() {
+        let cyclic = hop_library(true);
+        let lib = Library::from_bytes(&cyclic).unwrap();
+        let ev = run(&lib, &paused_hops(2, 0.9));
+        assert_eq!(
+            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            [false, false]
+        );
+        // A one-shot action repeated after a short pause is two actions.
+        let once = hop_library(false);
+        let lib = Library::from_bytes(&once).unwrap();
+        let ev = run(&lib, &paused_hops(2, 0.35));
+        assert_eq!(
+            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            [false, false]
+        );
+        assert!(ev[1].start_us > ev[0].end_us);
     }
 
     fn any_sample() -> impl Strategy<Value = Sample> {

@@ -22,6 +22,12 @@ pub const PAUSE_US: u64 = 120_000;
 /// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
 /// pauses briefly between hops without ending.
 pub const CYCLIC_PAUSE_US: u64 = 260_000;
+/// Stillness after a cyclic action's event up to which its next cycle continues that event
+/// (instead of starting a new one), µs.
+pub const CONTINUE_US: u64 = 500_000;
+/// Moving runs that may lie between a cyclic action's event and the next cycle that continues
+/// it: strokes the two matches left out at their edges (a hop's take-off before its `uf`).
+pub const CONTINUE_GAP_RUNS: usize = 2;
 /// Stillness inside a longer action that does not yet commit a shorter pending one, µs: a
 /// punch held at full reach, a crouch held low.
 pub const HOLD_US: u64 = 500_000;

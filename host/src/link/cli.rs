@@ -11,7 +11,7 @@ use super::blobs::{self, Blobs};
 use super::replay::{replay_log, ReplayOptions};
 use super::transport::{serial_ports, PortSpec};
 use super::Device;
-use crate::events::write_event;
+use crate::events::event_line;
 use crate::poselog::PoseLog;
 
 /// Arguments of `figurine devices`.
@@ -165,8 +165,10 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
             speed: args.speed,
             ..ReplayOptions::default()
         },
-        |rec| {
-            if let Err(e) = write_event(&mut out, rec).and_then(|()| out.flush()) {
+        |rec, continues| {
+            if let Err(e) =
+                writeln!(out, "{}", event_line(rec, continues)).and_then(|()| out.flush())
+            {
                 write_err.get_or_insert(e);
             }
         },

@@ -41,6 +41,17 @@ pub struct HostRxCounters {
     pub rejected: AtomicU32,
 }
 
+/// An action event as it arrived from the device.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Received {
+    /// The event (for a continuation: the whole extended segment).
+    pub event: ActionEvent,
+    /// It continues the previous event (`DeviceToHost::Continued`) and replaces it.
+    pub continues: bool,
+    /// When the host decoded its frame.
+    pub at: Instant,
+}
+
 /// A connected figurine.
 pub struct Device {
     spec: PortSpec,
@@ -280,25 +291,22 @@ impl Device {
         }
     }
 
-    /// Action events received so far (removed from the backlog, in order).
-    pub fn take_events(&mut self) -> Result<Vec<ActionEvent>, LinkError> {
-        Ok(self
-            .take_timed_events()?
-            .into_iter()
-            .map(|(e, _)| e)
-            .collect())
-    }
-
-    /// Like [`Device::take_events`], with the moment each event's frame was decoded.
-    pub fn take_timed_events(&mut self) -> Result<Vec<(ActionEvent, Instant)>, LinkError> {
+    /// Action events and continuations received so far (removed from the backlog, in order).
+    pub fn take_events(&mut self) -> Result<Vec<Received>, LinkError> {
         self.drain_now()?;
         let mut events = Vec::new();
-        self.backlog.retain(|(m, at)| match m {
-            DeviceToHost::Event(e) => {
-                events.push((*e, *at));
-                false
-            }
-            _ => true,
+        self.backlog.retain(|(m, at)| {
+            let (event, continues) = match m {
+                DeviceToHost::Event(e) => (*e, false),
+                DeviceToHost::Continued(e) => (*e, true),
+                _ => return true,
+            };
+            events.push(Received {
+                event,
+                continues,
+                at: *at,
+            });
+            false
         });
         Ok(events)
     }

@@ -27,6 +27,7 @@ use figurine_protocol::{HostToDevice, Pose};
 use super::blobs;
 use super::replay::record_with_times;
 use super::{Device, PortSpec};
+use crate::events::{event_line, ActionRecord};
 use crate::poselog::PoseSample;
 use crate::render::puppet::PuppetMessage;
 
@@ -110,6 +111,8 @@ struct Session<'a> {
     many: bool,
     /// With `--view`: this figurine's character and the puppets' channel.
     puppet: Option<(u16, Sender<PuppetMessage>)>,
+    /// The last action sent to the puppet (a continuation plays on from its end).
+    last: Option<ActionRecord>,
 }
 
 impl Session<'_> {
@@ -148,13 +151,14 @@ impl Session<'_> {
             Ok(e) => e,
             Err(e) => return self.lost(&e),
         };
-        for e in events {
+        for r in events {
             let times = &self.times;
-            let rec = record_with_times(&e, self.names, self.sent.saturating_sub(1), |i| {
+            let rec = record_with_times(&r.event, self.names, self.sent.saturating_sub(1), |i| {
                 times.get(i % SEQ_RING).copied().unwrap_or(f64::NAN)
             });
-            // Same JSON line as `simulate --jsonl`, plus the port with several figurines.
-            let mut line = serde_json::to_string(&rec).unwrap_or_default();
+            // Same JSON line as `simulate --jsonl` (a continuation marked as such), plus the
+            // port with several figurines.
+            let mut line = event_line(&rec, r.continues);
             if self.many && line.ends_with('}') {
                 line.pop();
                 let label = serde_json::to_string(&self.label).unwrap_or_default();
@@ -165,8 +169,17 @@ impl Session<'_> {
                 let _ = out.flush();
             }
             if let Some((character, tx)) = &self.puppet {
+                // A continuation plays on from where the action had got to: the puppet is
+                // sent only the new part.
+                let play = match self.last.replace(rec.clone()) {
+                    Some(prev) if r.continues && prev.action == rec.action => ActionRecord {
+                        start: prev.end.min(rec.end),
+                        ..rec
+                    },
+                    _ => rec,
+                };
                 // The viewer may already be gone; the session goes on regardless.
-                let _ = tx.send((*character, rec, Instant::now()));
+                let _ = tx.send((*character, play, Instant::now()));
             }
         }
     }
@@ -254,6 +267,7 @@ fn run_session(
         print,
         many,
         puppet,
+        last: None,
     };
     s.ensure_connected();
     if let Some(dev) = s.dev.as_mut() {

@@ -42,10 +42,14 @@ impl Default for ReplayOptions {
 /// What a replay produced.
 #[derive(Debug, Clone)]
 pub struct Replay {
-    /// Events as JSON-lines records (names, log seconds, efforts q/127), like `simulate`.
+    /// Events as JSON-lines records (names, log seconds, efforts q/127), like `simulate`:
+    /// one per action, continuations folded in.
     pub records: Vec<ActionRecord>,
-    /// The device's events as received, with the moment the host decoded each.
+    /// The device's events as received, each continuation in place of the event it
+    /// continues, with the moment the host decoded the latest.
     pub events: Vec<(ActionEvent, Instant)>,
+    /// Continuations received (each folded into the event it continues).
+    pub continued: u32,
     /// When each log sample was sent (`None`: the wire cannot carry it).
     pub sent_at: Vec<Option<Instant>>,
     /// Device statistics at the end of the log (before the closing reset).
@@ -96,13 +100,14 @@ pub fn record_with_times(
 }
 
 /// Replays `log` through `dev` (after resetting its session) and returns its events.
-/// `on_event` sees each record as soon as it arrives.
+/// `on_event` sees each record as soon as it arrives, and whether it continues (replaces) the
+/// previous one.
 pub fn replay_log(
     dev: &mut Device,
     log: &PoseLog,
     names: &[String],
     opts: ReplayOptions,
-    mut on_event: impl FnMut(&ActionRecord),
+    mut on_event: impl FnMut(&ActionRecord, bool),
 ) -> Result<Replay, LinkError> {
     dev.reset()?;
     dev.take_events()?;
@@ -110,6 +115,7 @@ pub fn replay_log(
     let mut out = Replay {
         records: Vec::new(),
         events: Vec::new(),
+        continued: 0,
         sent_at: vec![None; log.samples.len()],
         stats: Stats::default(),
         unsendable: 0,
@@ -117,12 +123,20 @@ pub fn replay_log(
     let mut last_sent = 0usize;
     let mut collect =
         |dev: &mut Device, out: &mut Replay, last_sent: usize| -> Result<(), LinkError> {
-            let now = Instant::now();
-            for e in dev.take_events()? {
-                let rec = to_record(&e, names, log, last_sent);
-                on_event(&rec);
-                out.records.push(rec);
-                out.events.push((e, now));
+            for r in dev.take_events()? {
+                let rec = to_record(&r.event, names, log, last_sent);
+                on_event(&rec, r.continues);
+                out.continued += u32::from(r.continues);
+                match (r.continues, out.records.last_mut(), out.events.last_mut()) {
+                    (true, Some(last_rec), Some(last_ev)) if last_ev.0.seq == r.event.seq => {
+                        *last_rec = rec;
+                        *last_ev = (r.event, r.at);
+                    }
+                    _ => {
+                        out.records.push(rec);
+                        out.events.push((r.event, r.at));
+                    }
+                }
             }
             Ok(())
         };

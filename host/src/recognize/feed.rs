@@ -85,14 +85,24 @@ impl Clock {
     }
 }
 
-/// Runs the recognizer over a whole log; returns the events in time order.
+/// Runs the recognizer over a whole log; returns the actions in time order, each continuation
+/// ([`ActionEvent::continues`]) folded into the event it continues (which then carries the
+/// decision time of its last update).
 pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> Vec<ActionEvent> {
     let mut events = Vec::new();
     for (_, s) in samples {
-        rec.push(s, |e| events.push(e));
+        rec.push(s, |e| fold_event(&mut events, e));
     }
-    rec.flush(|e| events.push(e));
+    rec.flush(|e| fold_event(&mut events, e));
     events
+}
+
+/// Appends `e` to `events`, or replaces the last event with it when `e` continues it.
+pub fn fold_event(events: &mut Vec<ActionEvent>, e: ActionEvent) {
+    match events.last_mut() {
+        Some(last) if e.continues && last.action == e.action => *last = e,
+        _ => events.push(e),
+    }
 }
 
 /// All token runs of a log (STILL included), in order, with their feature sums.

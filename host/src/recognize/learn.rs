@@ -509,8 +509,9 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             }
         }
         // The whole gesture may repeat (cyclic actions: walk, wave …; a repeated one-shot
-        // action is then one event over all repetitions).
-        let re = if cyclic {
+        // action is then one event over all repetitions). A stroke every example repeats
+        // (a run's strides) is cyclic too: strides after a short pause continue the run.
+        let re = if cyclic || doubled.is_some() {
             Regex::Plus(Box::new(Regex::Cat(items)))
         } else {
             Regex::Cat(items)
@@ -901,6 +902,8 @@ mod tests {
         let f = parse_token("f").unwrap();
         assert!(!c.accepts(&[f]), "{}", re.to_source());
         assert!(c.accepts(&[f, f, f]), "{}", re.to_source());
+        // Repeated strides make it cyclic: more strides after a pause continue the run.
+        assert!(c.cyclic, "{}", re.to_source());
         // One example with a single stroke: one is enough.
         let seqs = vec![seq("f:0.3 f.Zp:0.1 f:0.3"), seq("f:0.6")];
         let re = learn_regex(&seqs).unwrap();
