@@ -366,6 +366,7 @@ impl<'lib> Recognizer<'lib> {
                 distance: k,
                 len: (j + 1) as u16,
                 min_len: p.min_len().min(255) as u8,
+                positions: p.positions().min(255) as u8,
                 cyclic: p.cyclic(),
             };
             if best.is_none_or(|b| c.beats(&b)) {

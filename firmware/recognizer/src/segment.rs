@@ -64,6 +64,8 @@ pub struct Candidate {
     pub len: u16,
     /// Shortest match of the action's pattern (its specificity), tokens.
     pub min_len: u8,
+    /// Positions of the action's pattern: fewer accept fewer strings (a tighter pattern).
+    pub positions: u8,
     /// The pattern can repeat as a whole (a cyclic action: walk, wave …).
     pub cyclic: bool,
 }
@@ -75,10 +77,23 @@ impl Candidate {
     }
 
     /// True when `self` should replace `other`: higher merit; at equal merit the more
-    /// specific pattern (longer shortest match), then fewer edits, then the lower index.
+    /// specific pattern (longer shortest match, then fewer positions: a pattern that accepts
+    /// fewer strings explains the match better than one that merely allows it), then fewer
+    /// edits, then the lower index.
     pub fn beats(&self, other: &Candidate) -> bool {
-        (self.merit(), self.min_len, other.distance, other.action)
-            > (other.merit(), other.min_len, self.distance, self.action)
+        (
+            self.merit(),
+            self.min_len,
+            other.positions,
+            other.distance,
+            other.action,
+        ) > (
+            other.merit(),
+            other.min_len,
+            self.positions,
+            self.distance,
+            self.action,
+        )
     }
 }
 
@@ -174,6 +189,7 @@ mod tests {
             distance,
             len: (end - start + 1) as u16,
             min_len: 1,
+            positions: 1,
             cyclic: false,
         }
     }
@@ -191,6 +207,27 @@ mod tests {
             assert_eq!(d.offer(None, 0), Decision::Wait);
         }
         assert_eq!(d.offer(None, 0), Decision::Commit(c(1, 1, 5, 1)));
+    }
+
+    #[test]
+    fn at_equal_merit_the_tighter_pattern_wins() {
+        // `d u` matched exactly by a crouch (`d+ u+`, 2 positions) and by a jump whose landing
+        // is optional (`d+ u+ (f|df|d)*`, 5 positions): the crouch explains it better.
+        let crouch = Candidate {
+            min_len: 2,
+            positions: 2,
+            ..c(8, 1, 2, 0)
+        };
+        let jump = Candidate {
+            min_len: 2,
+            positions: 5,
+            ..c(2, 1, 2, 0)
+        };
+        assert!(crouch.beats(&jump));
+        assert!(!jump.beats(&crouch));
+        // A longer shortest match still comes first: it is the more specific gesture.
+        let jump = Candidate { min_len: 3, ..jump };
+        assert!(jump.beats(&crouch));
     }
 
     #[test]

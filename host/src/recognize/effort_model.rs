@@ -1,13 +1,15 @@
 //! The effort model as a file (EFFORT.json) and as the device blob.
 //!
-//! Human-readable: per axis the selected features (index and name), the Gaussian parameters
-//! per class, the prior, and the cross-validated accuracy; plus the device blob as hex
-//! (`figurine_recognizer::bayes` layout), rebuilt from the parameters on load.
+//! Human-readable: per axis the classifier, the selected features (index and name), the
+//! Gaussian parameters per class, the prior — and for a linear discriminant its weights and
+//! bias — and the cross-validated accuracy; plus the device blob as hex
+//! (`figurine_recognizer::bayes` layout), rebuilt from the parameters on load. Files without a
+//! `classifier` (written before it existed) are naive Bayes.
 
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use figurine_recognizer::bayes::{AxisModel, EffortModel, MAX_EFFORT_FEATURES};
+use figurine_recognizer::bayes::{AxisModel, Classifier, EffortModel, MAX_EFFORT_FEATURES};
 use figurine_recognizer::features::{FEATURES, QUANTITIES, QUANTITY_NAMES};
 use serde::{Deserialize, Serialize};
 
@@ -40,6 +42,20 @@ pub struct FeatureParams {
     pub positive: [f32; 2],
     /// Mean and variance for the negative class (sustained / light).
     pub negative: [f32; 2],
+    /// Linear discriminant: this feature's weight in the log-odds (per feature unit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weight: Option<f32>,
+}
+
+/// Which classifier an axis uses (see `figurine_recognizer::bayes`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ClassifierKind {
+    /// Gaussian naive Bayes over the class parameters.
+    #[default]
+    NaiveBayes,
+    /// Linear discriminant: `bias + Σ weight·feature`.
+    Linear,
 }
 
 /// One axis of the model.
@@ -47,8 +63,14 @@ pub struct FeatureParams {
 pub struct AxisFile {
     /// What the positive class is (`sudden` or `strong`).
     pub positive_class: String,
+    /// The classifier.
+    #[serde(default)]
+    pub classifier: ClassifierKind,
     /// Prior log-odds of the positive class.
     pub prior_log_odds: f32,
+    /// Linear discriminant: the log-odds at all-zero features (the prior included).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias: Option<f32>,
     /// Selected features, most relevant first.
     pub features: Vec<FeatureParams>,
     /// Cross-validated accuracy with these features (0..1), if trained.
@@ -73,12 +95,14 @@ pub struct EffortFile {
 }
 
 impl AxisFile {
-    fn to_device(&self) -> Result<AxisModel> {
+    /// The device form of this axis.
+    pub fn to_device(&self) -> Result<AxisModel> {
         let m = self.features.len();
         if m == 0 || m > MAX_EFFORT_FEATURES {
             bail!("{m} features; the device takes 1 to {MAX_EFFORT_FEATURES}");
         }
         let mut ax = AxisModel {
+            kind: Classifier::NaiveBayes,
             m: m as u8,
             idx: [0; MAX_EFFORT_FEATURES],
             prior: self.prior_log_odds,
@@ -86,7 +110,21 @@ impl AxisFile {
         };
         for (k, f) in self.features.iter().enumerate() {
             ax.idx[k] = f.index;
-            ax.params[k] = [f.positive[0], f.positive[1], f.negative[0], f.negative[1]];
+            ax.params[k] = match self.classifier {
+                ClassifierKind::NaiveBayes => {
+                    [f.positive[0], f.positive[1], f.negative[0], f.negative[1]]
+                }
+                ClassifierKind::Linear => {
+                    let Some(w) = f.weight else {
+                        bail!("linear axis: feature {} has no weight", f.name);
+                    };
+                    [w, 0.0, 0.0, 0.0]
+                }
+            };
+        }
+        if self.classifier == ClassifierKind::Linear {
+            ax.kind = Classifier::Linear;
+            ax.prior = self.bias.context("linear axis without a bias")?;
         }
         Ok(ax)
     }
@@ -165,16 +203,26 @@ mod tests {
     fn round_trips_and_validates() {
         let ax = |c: &str| AxisFile {
             positive_class: c.into(),
+            classifier: ClassifierKind::NaiveBayes,
             prior_log_odds: 0.0,
+            bias: None,
             features: vec![FeatureParams {
                 index: 18,
                 name: feature_name(18),
                 positive: [1.0, 0.5],
                 negative: [-1.0, 0.5],
+                weight: None,
             }],
             cv_accuracy: Some(0.9),
         };
-        let f = EffortFile::new(ax("sudden"), ax("strong")).unwrap();
+        let mut linear = ax("strong");
+        linear.classifier = ClassifierKind::Linear;
+        linear.bias = Some(-0.5);
+        linear.features[0].weight = Some(1.5);
+        let f = EffortFile::new(ax("sudden"), linear).unwrap();
+        let m = f.model().unwrap();
+        assert_eq!(m.weight.kind, Classifier::Linear);
+        assert_eq!((m.weight.prior, m.weight.params[0][0]), (-0.5, 1.5));
         let text = serde_json::to_string(&f).unwrap();
         assert_eq!(EffortFile::from_json(&text).unwrap(), f);
         assert_eq!(feature_name(18), "mean(world.speed)");
@@ -182,5 +230,12 @@ mod tests {
         let mut bad = f.clone();
         bad.time.features[0].positive[1] = 0.0;
         assert!(bad.model().is_err());
+        let mut bad = f.clone();
+        bad.weight.features[0].weight = None;
+        assert!(bad.model().is_err());
+        // A file from before classifiers were named is naive Bayes.
+        let old = text.replace(r#""classifier":"naive-bayes","#, "");
+        assert!(!old.contains("classifier\":\"naive"), "{old}");
+        assert_eq!(EffortFile::from_json(&old).unwrap(), f);
     }
 }

@@ -26,6 +26,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
+use figurine_recognizer::segment::edits_fit;
 use figurine_recognizer::token::{
     mirror_token, symbol_matches, token_from_signs, token_signs, Symbol, Token, ANY_LIN, ANY_ROT,
     NONE_BIN, STILL, TURN,
@@ -382,6 +383,8 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     let n = ref_m.len();
     let mut cols: Vec<BTreeSet<Token>> = ref_m.iter().map(|&t| BTreeSet::from([t])).collect();
     let mut missing = vec![0usize; n];
+    // Columns a performance too short to afford one edit on the device lacks.
+    let mut lacked_by_short = vec![false; n];
     // gaps[g][k]: optional tokens of sequence k before column g (g = n: after the last).
     let mut gaps: Vec<Vec<Vec<Token>>> = vec![vec![Vec::new(); seqs.len()]; n + 1];
     for (k, s) in seqs.iter().enumerate() {
@@ -397,7 +400,10 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                     cols[i].insert(mt[j]);
                     col_of[j] = Some(i);
                 }
-                Op::Del(i) => missing[i] += 1,
+                Op::Del(i) => {
+                    missing[i] += 1;
+                    lacked_by_short[i] |= !edits_fit(1, s.len());
+                }
                 Op::Ins(_) => {}
             }
         }
@@ -457,10 +463,15 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             opt_support.push(per_seq.iter().filter(|v| !v.is_empty()).count());
         }
     }
-    // A column is optional when most sequences lack it — but a pattern keeps at least
+    // A column is optional when most sequences lack it, or one too short to afford an edit on
+    // the device (`edits_fit`) does — but a pattern keeps at least
     // [`MIN_MANDATORY`] mandatory column (the best supported): one made only of optional
     // parts matches any lone token of its alphabet.
-    let mut optional_col: Vec<bool> = missing.iter().map(|&m| 2 * m >= seqs.len()).collect();
+    let mut optional_col: Vec<bool> = missing
+        .iter()
+        .zip(&lacked_by_short)
+        .map(|(&m, &short)| 2 * m >= seqs.len() || short)
+        .collect();
     let mut by_support: Vec<usize> = (0..n).collect();
     by_support.sort_by_key(|&g| (missing[g], g));
     for &g in by_support.iter().take(MIN_MANDATORY.min(n)) {
@@ -796,6 +807,30 @@ mod tests {
         ];
         let re = learn_regex(&seqs).unwrap();
         assert_eq!(re.to_source(), "u+ f* d+");
+    }
+
+    #[test]
+    fn a_column_lacked_by_an_example_too_short_for_an_edit_becomes_optional() {
+        // The device allows no edit in a two-token match, so a column the short performance
+        // lacks must not be required, or that performance would never be recognised.
+        let seqs = vec![
+            seq("lu:0.3 l:0.3 lu:0.3 l:0.3"),
+            seq("lu:0.3 l:0.3 ld:0.2"),
+            seq("lu:0.4 lu:0.4"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        let t = |s: &str| parse_token(s).unwrap();
+        assert!(c.accepts(&[t("lu"), t("lu")]), "{}", re.to_source());
+        assert!(c.accepts(&[t("lu"), t("l"), t("ld")]), "{}", re.to_source());
+        // A long performance lacking a column still only costs an edit: the column stays.
+        let seqs = vec![
+            seq("lu:0.3 l:0.3 ld:0.3 u:0.3"),
+            seq("lu:0.3 l:0.3 ld:0.2 u:0.3"),
+            seq("lu:0.3 ld:0.3 u:0.3 b:0.3"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(re.to_source().contains("l+"), "{}", re.to_source());
     }
 
     #[test]

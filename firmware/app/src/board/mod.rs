@@ -12,7 +12,7 @@ use figurine_store::TwoSlotStore;
 /// Bytes of one library slot: the recognizer's largest library (11,656 B) + header, in
 /// whole 4 KiB pages.
 pub const LIBRARY_SLOT: u32 = 16 * 1024;
-/// Bytes of one effort-model slot (largest model 558 B + header).
+/// Bytes of one effort-model slot (largest model 560 B + header).
 pub const EFFORT_SLOT: u32 = 4 * 1024;
 /// Library slots at the start of the board's store region.
 pub const LIBRARY_STORE: TwoSlotStore = TwoSlotStore::new(0, LIBRARY_SLOT);

@@ -4,7 +4,7 @@
 //! as skipped; events have end ≥ start.
 #![no_main]
 
-use figurine_recognizer::bayes::{AxisModel, EffortModel, MAX_EFFORT_FEATURES};
+use figurine_recognizer::bayes::{AxisModel, Classifier, EffortModel, MAX_EFFORT_FEATURES};
 use figurine_recognizer::pattern::encode_record;
 use figurine_recognizer::token::parse_token;
 use figurine_recognizer::{Library, Recognizer, Sample};
@@ -26,9 +26,17 @@ fn library() -> Vec<u8> {
 }
 
 fn effort() -> EffortModel {
-    let mut ax = AxisModel { m: 2, idx: [0; MAX_EFFORT_FEATURES], prior: 0.1, params: [[0.0, 1.0, 1.0, 2.0]; MAX_EFFORT_FEATURES] };
+    let mut ax = AxisModel {
+        kind: Classifier::NaiveBayes,
+        m: 2,
+        idx: [0; MAX_EFFORT_FEATURES],
+        prior: 0.1,
+        params: [[0.0, 1.0, 1.0, 2.0]; MAX_EFFORT_FEATURES],
+    };
     ax.idx[1] = 19;
-    EffortModel { time: ax, weight: ax }
+    // Both classifiers run on every committed segment.
+    let weight = AxisModel { kind: Classifier::Linear, ..ax };
+    EffortModel { time: ax, weight }
 }
 
 fuzz_target!(|data: &[u8]| {
