@@ -219,7 +219,9 @@ pub fn fit_linear(ex: &[&Example], axis: Axis, features: &[usize]) -> AxisFile {
         for (r, row) in a.iter_mut().enumerate() {
             if r != col {
                 let f = row[col];
-                row.iter_mut().zip(&pivot_row).for_each(|(v, p)| *v -= f * p);
+                row.iter_mut()
+                    .zip(&pivot_row)
+                    .for_each(|(v, p)| *v -= f * p);
             }
         }
     }
@@ -463,7 +465,9 @@ mod tests {
     fn examples() -> Vec<Example> {
         let mut state = 12345u64;
         let mut uniform = move || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         (0..200)
