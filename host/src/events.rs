@@ -6,10 +6,11 @@
 //! renderer draws it as a timeline, the device link prints it.
 //!
 //! Streams printed while a figurine plays (`figurine live`, `figurine replay`) may also hold
-//! continuation lines, the same object plus `"continues":true`: the previous action went on
-//! (a walk's next hops after a short pause) and this line, with the same start and a later
-//! end, replaces it. [`read_events`] folds them, so such a stream reads as one object per
-//! action, like `simulate`'s.
+//! revision lines, the same object plus `"revises":true`, which replace the line before: the
+//! action went on (a walk's next hops after a short pause: same start, a later end), or a
+//! longer action took over one reported early (a punch held at full reach after strides
+//! that alone read as a run). [`read_events`] folds them, so such a stream reads as one
+//! object per action, like `simulate`'s.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -78,7 +79,7 @@ pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>,
         if line.trim().is_empty() {
             continue;
         }
-        let Line { rec, continues } =
+        let Line { rec, revises } =
             serde_json::from_str(&line).map_err(|e| EventsError::Malformed {
                 path: name.to_path_buf(),
                 line: i + 1,
@@ -92,20 +93,20 @@ pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>,
             });
         }
         match out.last_mut() {
-            Some(last) if continues && last.action == rec.action => *last = rec,
+            Some(last) if revises => *last = rec,
             _ => out.push(rec),
         }
     }
     Ok(out)
 }
 
-/// One line of an event stream: an action, possibly continuing the previous one.
+/// One line of an event stream: an action, possibly revising the previous one.
 #[derive(Deserialize)]
 struct Line {
     #[serde(flatten)]
     rec: ActionRecord,
     #[serde(default)]
-    continues: bool,
+    revises: bool,
 }
 
 /// Writes one event as a JSON line.
@@ -115,12 +116,12 @@ pub fn write_event<W: Write>(mut w: W, rec: &ActionRecord) -> std::io::Result<()
 }
 
 /// The JSON line of an action update: `rec` itself when it is a new action, `rec` plus
-/// `"continues":true` when it continues (and replaces) the previous line's action.
-pub fn event_line(rec: &ActionRecord, continues: bool) -> String {
+/// `"revises":true` when it revises (replaces) the previous line's action.
+pub fn event_line(rec: &ActionRecord, revises: bool) -> String {
     let mut line = serde_json::to_string(rec).unwrap_or_default();
-    if continues && line.ends_with('}') {
+    if revises && line.ends_with('}') {
         line.pop();
-        line.push_str(",\"continues\":true}");
+        line.push_str(",\"revises\":true}");
     }
     line
 }
@@ -130,7 +131,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_continuation_line_replaces_the_action_it_continues() {
+    fn a_revision_line_replaces_the_action_before_it() {
         let walk = ActionRecord {
             action: "walk".into(),
             start: 1.0,
@@ -150,15 +151,29 @@ mod tests {
             end: 4.6,
             ..walk.clone()
         };
+        // A run reported early, then taken over by the punch it was the start of.
+        let run = ActionRecord {
+            action: "run".into(),
+            start: 5.0,
+            end: 5.4,
+            ..walk.clone()
+        };
+        let punch = ActionRecord {
+            action: "punch".into(),
+            end: 6.1,
+            ..run.clone()
+        };
         let text = [
             event_line(&walk, false),
             event_line(&longer, true),
             event_line(&jump, false),
+            event_line(&run, false),
+            event_line(&punch, true),
         ]
         .join("\n");
-        assert!(text.contains(r#""distance":1,"continues":true}"#), "{text}");
+        assert!(text.contains(r#""distance":1,"revises":true}"#), "{text}");
         let got = read_events(text.as_bytes(), Path::new("stream.jsonl")).unwrap();
-        assert_eq!(got, [longer, jump]);
+        assert_eq!(got, [longer, jump, punch]);
     }
 
     #[test]

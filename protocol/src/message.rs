@@ -67,7 +67,7 @@ pub struct DeviceHello {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ActionEvent {
     /// Event counter, +1 per event, wrapping; a gap means an event was lost. A
-    /// [`DeviceToHost::Continued`] repeats the counter of the event it continues.
+    /// [`DeviceToHost::Revised`] repeats the counter of the event it replaces.
     pub seq: u8,
     /// Index of the action in the uploaded library.
     pub action: u8,
@@ -236,11 +236,13 @@ pub enum DeviceToHost {
     Error(DeviceError),
     /// Answer to `Ping`, echoing its value.
     Pong(u32),
-    /// The previous `Event` (same `seq`) goes on: the next cycle of a cyclic action (a walk's
-    /// next hops after a short pause) extended it. It carries the whole segment, with effort
-    /// and distance over all of it, and replaces that event — it is not a new action. Sent
-    /// only right after the event it continues (or after another continuation of it).
-    Continued(ActionEvent),
+    /// The previous `Event` (same `seq`) revised, to be replaced by this one: the next cycles
+    /// of a cyclic action (a walk's next hops after a short pause) extended it — this carries
+    /// the whole segment, effort and distance over all of it — or a longer action took over
+    /// an event reported while the figurine paused inside it (a punch held at full reach
+    /// after strides that alone read as a run). Sent only right after the event it revises
+    /// (or after another revision of it).
+    Revised(ActionEvent),
 }
 
 /// Reads the protocol version from a `Hello` payload of *any* version (variant 0 with the

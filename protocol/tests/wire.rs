@@ -71,8 +71,8 @@ fn samples() -> Vec<(&'static str, Vec<u8>)> {
             })),
         ),
         (
-            "continued",
-            d(DeviceToHost::Continued(ActionEvent {
+            "revised",
+            d(DeviceToHost::Revised(ActionEvent {
                 seq: 9,
                 action: 3,
                 end_seq: 40_100,

@@ -38,10 +38,10 @@ fn check_identical(dev: &mut Device, blobs: &Blobs, log: &PoseLog, what: &str) -
         "{what}: invalid samples"
     );
     assert_eq!(got.records.len(), sim.records.len(), "{what}: event count");
-    // The recognizer counts every emission, continuations included.
-    let sim_continued = sim.stats.events - sim.events.len() as u32;
-    assert_eq!(got.continued, sim_continued, "{what}: continuations");
-    eprintln!("{what}: {sim_continued} continuations");
+    // The recognizer counts every emission, revisions included.
+    let sim_revised = sim.stats.events - sim.events.len() as u32;
+    assert_eq!(got.revised, sim_revised, "{what}: revisions");
+    eprintln!("{what}: {sim_revised} revisions");
     for (i, (d, s)) in got.records.iter().zip(&sim.records).enumerate() {
         assert_eq!(d, s, "{what}: event {i}");
     }
@@ -92,20 +92,21 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
         events > 0,
         "the synthetic sequences produced no events at all"
     );
-    // A sequence in which a cyclic action (walk, run, wave in the default library) goes on
-    // after a pause: the device's `Continued` messages must match the simulation's.
+    // A sequence with revised events (a cyclic action going on after a pause, or an action
+    // reported early and then taken over by a longer one): the device's `Revised` messages
+    // must match the simulation's.
     let defaults = blobs::load(None, None).expect("default blobs");
     let effort = EffortModel::from_bytes(&defaults.effort).expect("effort blob");
-    let continued = (4u64..60)
+    let revised = (4u64..60)
         .map(|seed| sequence(seed, &knobs, 6, None))
         .find(|d| {
             let sim = simulate_log(&d.log, &defaults.names, &defaults.library, Some(effort))
                 .expect("simulate");
             sim.stats.events > sim.events.len() as u32
         })
-        .expect("no synthetic sequence with a continued action");
+        .expect("no synthetic sequence with a revised event");
     upload_to(&mut dev, &defaults, true).expect("upload the default library");
-    check_identical(&mut dev, &defaults, &continued.log, "a continued action");
+    check_identical(&mut dev, &defaults, &revised.log, "revised events");
     upload_to(&mut dev, &blobs, true).expect("upload");
 
     for name in ["tum_fr1_xyz_groundtruth.txt", "euroc_v102_groundtruth.csv"] {

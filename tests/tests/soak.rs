@@ -113,7 +113,7 @@ impl Progress {
     /// that nothing was dropped.
     fn take(&mut self, m: DeviceToHost, base_dropped: u32, worst_late: Duration) {
         match m {
-            DeviceToHost::Event(_) | DeviceToHost::Continued(_) => self.events += 1,
+            DeviceToHost::Event(_) | DeviceToHost::Revised(_) => self.events += 1,
             DeviceToHost::Stats(s) => {
                 let (asked, poses) = self.asked.pop_front().expect("an unasked Stats");
                 self.last_lag = asked.elapsed();

@@ -123,8 +123,8 @@ impl Engine {
 
     async fn emit(&mut self, e: figurine_recognizer::ActionEvent) {
         let len = e.end_seq.wrapping_sub(e.start_seq).min(u32::from(u16::MAX)) as u16;
-        // A continuation repeats the counter of the event it extends.
-        let seq = if e.continues {
+        // A revision repeats the counter of the event it replaces.
+        let seq = if e.revises {
             self.event_seq.wrapping_sub(1)
         } else {
             self.event_seq
@@ -138,10 +138,10 @@ impl Engine {
             weight: e.weight_q,
             distance: e.distance,
         };
-        defmt::info!("event {} (continues: {})", msg, e.continues);
+        defmt::info!("event {} (revises: {})", msg, e.revises);
         stats::update(|s| s.events = s.events.wrapping_add(1));
-        if e.continues {
-            send_to_host(DeviceToHost::Continued(msg)).await;
+        if e.revises {
+            send_to_host(DeviceToHost::Revised(msg)).await;
         } else {
             self.event_seq = self.event_seq.wrapping_add(1);
             send_to_host(DeviceToHost::Event(msg)).await;

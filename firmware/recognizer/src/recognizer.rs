@@ -48,10 +48,12 @@ pub struct ActionEvent {
     pub decided_seq: u32,
     /// Time of that sample, µs (decision latency = this − `end_us`).
     pub decided_us: u64,
-    /// This event continues the previous one (same action, its `start`, a later `end`, effort
-    /// and distance over both): the next cycle of a walk after a short pause. A consumer
-    /// replaces the previous event with it instead of adding a new one.
-    pub continues: bool,
+    /// This event revises the previous one, which a consumer replaces with it: the next
+    /// cycles of a cyclic action after a short pause extended it (same action and start, a
+    /// later end, effort and distance over all of it), or a longer action took over a
+    /// candidate that had been reported early while it might still be part of one (a run's
+    /// strides that turned out to be a punch held at full reach).
+    pub revises: bool,
 }
 
 /// Running statistics.
@@ -92,6 +94,8 @@ pub struct Recognizer<'lib> {
     now_us: u64,
     now_seq: u32,
     held: Option<Held>,
+    /// The pending candidate already reported while a longer action may still take it over.
+    provisional: Option<Candidate>,
     /// The STILL run last checked for a longer action in progress, and the answer.
     hold: Option<(u32, bool)>,
 }
@@ -111,6 +115,7 @@ impl<'lib> Recognizer<'lib> {
             now_us: 0,
             now_seq: 0,
             held: None,
+            provisional: None,
             hold: None,
         }
     }
@@ -139,6 +144,7 @@ impl<'lib> Recognizer<'lib> {
     fn restart_matching(&mut self) {
         self.bank.reset();
         self.decider.clear();
+        self.provisional = None;
         self.floor = self
             .front
             .history()
@@ -166,6 +172,7 @@ impl<'lib> Recognizer<'lib> {
             // Runs before the gap are gone from history: commit what can be committed.
             self.decider.clear();
             self.bank.reset();
+            self.provisional = None;
             self.floor = self.front.history().oldest().unwrap_or(0);
         }
         for (index, token) in opened.iter().flatten().copied() {
@@ -194,6 +201,12 @@ impl<'lib> Recognizer<'lib> {
                 };
                 if let Decision::Commit(c) = self.decider.stillness(still, longer) {
                     self.commit(c, &mut emit);
+                } else if let Some(p) = self.decider.pending().filter(|_| longer) {
+                    // Held for a longer action that may yet take it over: reported now, and
+                    // revised if it is.
+                    if self.decider.stillness(still, false) != Decision::Wait {
+                        self.report_provisional(p, &mut emit);
+                    }
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
                 }
@@ -249,8 +262,8 @@ impl<'lib> Recognizer<'lib> {
             (0..self.library.len()).any(|a| {
                 a != usize::from(p.action)
                     && self.library.pattern(a).is_some_and(|pat| {
-                        // Only an action needing more tokens than `p` has is a longer one.
-                        pat.min_len() > usize::from(p.len) && prefix_alive(&pat, tokens, skip_first)
+                        // Its match so far covers all of `p` and needs more: a longer one.
+                        prefix_alive(&pat, tokens, skip_first)
                     })
             })
         };
@@ -260,7 +273,7 @@ impl<'lib> Recognizer<'lib> {
             || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
-    fn emit_held(&mut self, h: Held, continues: bool, emit: &mut impl FnMut(ActionEvent)) {
+    fn emit_held(&mut self, h: Held, revises: bool, emit: &mut impl FnMut(ActionEvent)) {
         let (lt, lw) = match &self.effort {
             Some(m) => m.classify(&segment_features(&h.acc)),
             None => (0.0, 0.0),
@@ -276,7 +289,7 @@ impl<'lib> Recognizer<'lib> {
             distance: h.distance,
             decided_seq: self.now_seq,
             decided_us: self.now_us,
-            continues,
+            revises,
         });
         self.events = self.events.saturating_add(1);
     }
@@ -376,9 +389,42 @@ impl<'lib> Recognizer<'lib> {
         best
     }
 
-    /// Commits a candidate: emits it — or, for a cyclic action, holds it so that the next
-    /// cycle of the same action, following after at most a short pause, extends it.
-    fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+    /// Reports the pending candidate `p` before it is committed (once), unless it would
+    /// continue the held event: the figurine has paused after it for as long as commits it,
+    /// and only a longer action in progress keeps it pending. The commit then revises the
+    /// report if that longer action took over (see [`ActionEvent::revises`]); a consumer has
+    /// the likely answer after the usual pause instead of after the hold.
+    fn report_provisional(&mut self, p: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+        if self.provisional.is_some() || self.continues_held(&p) {
+            return;
+        }
+        if let Some(h) = self.event_of(&p) {
+            self.provisional = Some(p);
+            self.held = None;
+            self.emit_held(h, false, emit);
+        }
+    }
+
+    /// Whether `c` would continue the held cyclic event: same action, nothing but stillness
+    /// and a few unmatched strokes (the edges of the cycles) between them.
+    fn continues_held(&self, c: &Candidate) -> bool {
+        let hist = self.front.history();
+        self.held.is_some_and(|h| {
+            let mut i = h.end_run.wrapping_add(1);
+            let mut moving = 0usize;
+            for _ in 0..HISTORY_RUNS {
+                if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
+                    break;
+                }
+                moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
+                i = i.wrapping_add(1);
+            }
+            h.action == c.action && moving <= CONTINUE_GAP_RUNS
+        })
+    }
+
+    /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).
+    fn event_of(&self, c: &Candidate) -> Option<Held> {
         let hist = self.front.history();
         let start = hist.get(c.start).map(|r| r.start);
         let end = hist.get(c.end).map(|r| r.end);
@@ -409,50 +455,53 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         let acc = hist.accum(from, to);
-        // Nothing but stillness and a few unmatched strokes (the edges of the cycles) between
-        // the held event and this one?
-        let contiguous = self.held.is_some_and(|h| {
-            let mut i = h.end_run.wrapping_add(1);
-            let mut moving = 0usize;
-            for _ in 0..HISTORY_RUNS {
-                if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
-                    break;
-                }
-                moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
-                i = i.wrapping_add(1);
-            }
-            moving <= CONTINUE_GAP_RUNS
-        });
-        self.bank.reset();
-        self.decider.clear();
-        self.floor = c.end.wrapping_add(1);
-        let (Some(start), Some(end)) = (start, end) else {
-            return;
-        };
+        let (start, end) = (start?, end?);
         if end.1.saturating_sub(start.1) < MIN_ACTION_US {
             // A flicker of a token or two that happens to spell a short pattern: no child's
-            // gesture is this brief. Its runs are consumed; nothing is emitted.
-            return;
+            // gesture is this brief.
+            return None;
         }
-        if let Some(mut h) = self.held.filter(|h| h.action == c.action && contiguous) {
-            h.end = end;
-            h.end_run = c.end;
-            h.distance = h.distance.max(c.distance);
-            h.acc.merge(&acc);
-            self.held = Some(h);
-            self.emit_held(h, true, emit);
-            return;
-        }
-        let h = Held {
+        Some(Held {
             action: c.action,
             start,
             end,
             end_run: c.end,
             distance: c.distance,
             acc,
-        };
-        self.held = c.cyclic.then_some(h);
-        self.emit_held(h, false, emit);
+        })
+    }
+
+    /// Commits a candidate and emits it: as a new event, as the continuation of the held
+    /// cyclic one (the next cycle after a short pause), or as the revision of the provisional
+    /// report of another candidate it took over (nothing, when it is that reported candidate).
+    /// A cyclic action's event stays held so that its next cycle can continue it.
+    fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+        let ev = self.event_of(&c);
+        let continues = self.continues_held(&c);
+        let provisional = self.provisional.take();
+        self.bank.reset();
+        self.decider.clear();
+        self.floor = c.end.wrapping_add(1);
+        // Its runs are consumed either way; a too-brief one is not emitted.
+        let Some(ev) = ev else { return };
+        if let Some(pv) = provisional {
+            self.held = c.cyclic.then_some(ev);
+            if pv != c {
+                self.emit_held(ev, true, emit);
+            }
+            return;
+        }
+        if let Some(mut h) = self.held.filter(|_| continues) {
+            h.end = ev.end;
+            h.end_run = c.end;
+            h.distance = h.distance.max(c.distance);
+            h.acc.merge(&ev.acc);
+            self.held = Some(h);
+            self.emit_held(h, true, emit);
+            return;
+        }
+        self.held = c.cyclic.then_some(ev);
+        self.emit_held(ev, false, emit);
     }
 }
 
@@ -588,7 +637,7 @@ mod tests {
         // (`CYCLIC_PAUSE_US`), shorter than the one that ends the action (`CONTINUE_US`).
         let ev = run(&lib, &paused_hops(3, 0.35));
         assert_eq!(
-            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
             [false, true, true],
             "{ev:?}"
         );
@@ -608,7 +657,7 @@ mod tests {
         let lib = Library::from_bytes(&cyclic).unwrap();
         let ev = run(&lib, &paused_hops(2, 0.9));
         assert_eq!(
-            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
             [false, false]
         );
         // A one-shot action repeated after a short pause is two actions.
@@ -616,10 +665,55 @@ mod tests {
         let lib = Library::from_bytes(&once).unwrap();
         let ev = run(&lib, &paused_hops(2, 0.35));
         assert_eq!(
-            ev.iter().map(|e| e.continues).collect::<Vec<_>>(),
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
             [false, false]
         );
         assert!(ev[1].start_us > ev[0].end_us);
+    }
+
+    /// A thrust forward (0.4 s), a pause of `hold_s`, the return (0.4 s), at 120 Hz.
+    fn thrust_and_return(hold_s: f32) -> Vec<Sample> {
+        let rate = 120.0f32;
+        let (still, stroke) = (0.6f32, 0.4f32);
+        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
+        let total = 2.0 * still + 2.0 * stroke + hold_s + 0.6;
+        (0..(total * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let out = ramp((t - still) / stroke);
+                let back = ramp((t - still - stroke - hold_s) / stroke);
+                Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, 1.0, 0.25 * (out - back)],
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn an_action_reported_during_a_hold_is_revised_by_the_longer_one() {
+        // "thrust" is the forward stroke alone; "jab" is the stroke and its return.
+        let blob = seq_library(&[(&["f"], 0), (&["f", "b"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &thrust_and_return(0.3));
+        assert_eq!(
+            ev.iter().map(|e| (e.action, e.revises)).collect::<Vec<_>>(),
+            [(0, false), (1, true)],
+            "{ev:?}"
+        );
+        // The thrust is out during the pause, before the return began; the jab replaces it.
+        assert!(ev[0].decided_us < 1_300_000, "{ev:?}");
+        assert_eq!(ev[1].start_us, ev[0].start_us);
+        assert!(ev[1].end_us > ev[0].end_us + 300_000);
+        // Held past HOLD_US: the thrust stands alone, and the return is no jab.
+        let ev = run(&lib, &thrust_and_return(0.9));
+        assert_eq!(
+            ev.iter().map(|e| (e.action, e.revises)).collect::<Vec<_>>(),
+            [(0, false)],
+            "{ev:?}"
+        );
     }
 
     fn any_sample() -> impl Strategy<Value = Sample> {

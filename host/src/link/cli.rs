@@ -165,9 +165,8 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
             speed: args.speed,
             ..ReplayOptions::default()
         },
-        |rec, continues| {
-            if let Err(e) =
-                writeln!(out, "{}", event_line(rec, continues)).and_then(|()| out.flush())
+        |rec, revises| {
+            if let Err(e) = writeln!(out, "{}", event_line(rec, revises)).and_then(|()| out.flush())
             {
                 write_err.get_or_insert(e);
             }

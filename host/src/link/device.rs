@@ -44,10 +44,10 @@ pub struct HostRxCounters {
 /// An action event as it arrived from the device.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Received {
-    /// The event (for a continuation: the whole extended segment).
+    /// The event (for a revision: the event that replaces the previous one).
     pub event: ActionEvent,
-    /// It continues the previous event (`DeviceToHost::Continued`) and replaces it.
-    pub continues: bool,
+    /// It revises the previous event (`DeviceToHost::Revised`) and replaces it.
+    pub revises: bool,
     /// When the host decoded its frame.
     pub at: Instant,
 }
@@ -291,19 +291,19 @@ impl Device {
         }
     }
 
-    /// Action events and continuations received so far (removed from the backlog, in order).
+    /// Action events and revisions received so far (removed from the backlog, in order).
     pub fn take_events(&mut self) -> Result<Vec<Received>, LinkError> {
         self.drain_now()?;
         let mut events = Vec::new();
         self.backlog.retain(|(m, at)| {
-            let (event, continues) = match m {
+            let (event, revises) = match m {
                 DeviceToHost::Event(e) => (*e, false),
-                DeviceToHost::Continued(e) => (*e, true),
+                DeviceToHost::Revised(e) => (*e, true),
                 _ => return true,
             };
             events.push(Received {
                 event,
-                continues,
+                revises,
                 at: *at,
             });
             false

@@ -111,7 +111,8 @@ struct Session<'a> {
     many: bool,
     /// With `--view`: this figurine's character and the puppets' channel.
     puppet: Option<(u16, Sender<PuppetMessage>)>,
-    /// The last action sent to the puppet (a continuation plays on from its end).
+    /// The last action sent to the puppet (a revision of the same action plays on from its
+    /// end).
     last: Option<ActionRecord>,
 }
 
@@ -156,9 +157,9 @@ impl Session<'_> {
             let rec = record_with_times(&r.event, self.names, self.sent.saturating_sub(1), |i| {
                 times.get(i % SEQ_RING).copied().unwrap_or(f64::NAN)
             });
-            // Same JSON line as `simulate --jsonl` (a continuation marked as such), plus the
+            // Same JSON line as `simulate --jsonl` (a revision marked as such), plus the
             // port with several figurines.
-            let mut line = event_line(&rec, r.continues);
+            let mut line = event_line(&rec, r.revises);
             if self.many && line.ends_with('}') {
                 line.pop();
                 let label = serde_json::to_string(&self.label).unwrap_or_default();
@@ -169,10 +170,11 @@ impl Session<'_> {
                 let _ = out.flush();
             }
             if let Some((character, tx)) = &self.puppet {
-                // A continuation plays on from where the action had got to: the puppet is
-                // sent only the new part.
+                // A revision of the same action (its next cycles) plays on from where the
+                // action had got to: the puppet is sent only the new part. Another action
+                // replaces the one playing.
                 let play = match self.last.replace(rec.clone()) {
-                    Some(prev) if r.continues && prev.action == rec.action => ActionRecord {
+                    Some(prev) if r.revises && prev.action == rec.action => ActionRecord {
                         start: prev.end.min(rec.end),
                         ..rec
                     },

@@ -43,13 +43,13 @@ impl Default for ReplayOptions {
 #[derive(Debug, Clone)]
 pub struct Replay {
     /// Events as JSON-lines records (names, log seconds, efforts q/127), like `simulate`:
-    /// one per action, continuations folded in.
+    /// one per action, revisions folded in.
     pub records: Vec<ActionRecord>,
-    /// The device's events as received, each continuation in place of the event it
-    /// continues, with the moment the host decoded the latest.
+    /// The device's events as received, each revision in place of the event it revises,
+    /// with the moment the host decoded the latest.
     pub events: Vec<(ActionEvent, Instant)>,
-    /// Continuations received (each folded into the event it continues).
-    pub continued: u32,
+    /// Revisions received (each folded into the event it revises).
+    pub revised: u32,
     /// When each log sample was sent (`None`: the wire cannot carry it).
     pub sent_at: Vec<Option<Instant>>,
     /// Device statistics at the end of the log (before the closing reset).
@@ -100,7 +100,7 @@ pub fn record_with_times(
 }
 
 /// Replays `log` through `dev` (after resetting its session) and returns its events.
-/// `on_event` sees each record as soon as it arrives, and whether it continues (replaces) the
+/// `on_event` sees each record as soon as it arrives, and whether it revises (replaces) the
 /// previous one.
 pub fn replay_log(
     dev: &mut Device,
@@ -115,7 +115,7 @@ pub fn replay_log(
     let mut out = Replay {
         records: Vec::new(),
         events: Vec::new(),
-        continued: 0,
+        revised: 0,
         sent_at: vec![None; log.samples.len()],
         stats: Stats::default(),
         unsendable: 0,
@@ -125,9 +125,9 @@ pub fn replay_log(
         |dev: &mut Device, out: &mut Replay, last_sent: usize| -> Result<(), LinkError> {
             for r in dev.take_events()? {
                 let rec = to_record(&r.event, names, log, last_sent);
-                on_event(&rec, r.continues);
-                out.continued += u32::from(r.continues);
-                match (r.continues, out.records.last_mut(), out.events.last_mut()) {
+                on_event(&rec, r.revises);
+                out.revised += u32::from(r.revises);
+                match (r.revises, out.records.last_mut(), out.events.last_mut()) {
                     (true, Some(last_rec), Some(last_ev)) if last_ev.0.seq == r.event.seq => {
                         *last_rec = rec;
                         *last_ev = (r.event, r.at);

@@ -85,9 +85,9 @@ impl Clock {
     }
 }
 
-/// Runs the recognizer over a whole log; returns the actions in time order, each continuation
-/// ([`ActionEvent::continues`]) folded into the event it continues (which then carries the
-/// decision time of its last update).
+/// Runs the recognizer over a whole log; returns the actions in time order, each revision
+/// ([`ActionEvent::revises`]) in place of the event it revises (so an event carries the
+/// decision time of its last version).
 pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> Vec<ActionEvent> {
     let mut events = Vec::new();
     for (_, s) in samples {
@@ -97,10 +97,10 @@ pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> V
     events
 }
 
-/// Appends `e` to `events`, or replaces the last event with it when `e` continues it.
+/// Appends `e` to `events`, or replaces the last event with it when `e` revises it.
 pub fn fold_event(events: &mut Vec<ActionEvent>, e: ActionEvent) {
     match events.last_mut() {
-        Some(last) if e.continues && last.action == e.action => *last = e,
+        Some(last) if e.revises => *last = e,
         _ => events.push(e),
     }
 }
