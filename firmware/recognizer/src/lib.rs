@@ -10,7 +10,8 @@
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
 //! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision) →
-//! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (naive Bayes Time/Weight). [`frontend`] and
+//! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (Time and
+//! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
 //!
 //! # Capacities and RAM (with 32 actions loaded)
@@ -23,9 +24,11 @@
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
 //!
-//! Latency: the filter adds 50 ms; an action is committed [`segment::PAUSE_US`] after the
+//! Latency: the filter adds 50 ms; an action is reported [`segment::PAUSE_US`] after the
 //! figurine stops, or [`segment::LOOKAHEAD_TOKENS`] tokens after it ends when actions follow
-//! each other without a pause.
+//! each other without a pause. When it may still change — the next cycle of a cyclic action,
+//! or a longer action it is part of, may follow — it is reported then all the same, and
+//! revised if it does change ([`ActionEvent::revises`]).
 #![no_std]
 #![forbid(unsafe_code)]
 

@@ -3,8 +3,9 @@
 //! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1 KiB,
-//! effort model 0.6 KiB, the last cyclic event (open to continuation) 0.2 KiB — 13.0 KiB in all (13,344 B by `size_of`,
-//! measured by a test) with 32 actions loaded.
+//! effort model 0.6 KiB, the last cyclic event (open to continuation) and the state before a
+//! provisional report 0.5 KiB — 13.3 KiB in all (13,648 B by `size_of`, measured by a test)
+//! with 32 actions loaded.
 
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
@@ -94,8 +95,9 @@ pub struct Recognizer<'lib> {
     now_us: u64,
     now_seq: u32,
     held: Option<Held>,
-    /// The pending candidate already reported while a longer action may still take it over.
-    provisional: Option<Candidate>,
+    /// The pending candidate already reported while it may still change, with the held event
+    /// as it was before the report and whether the report continued it.
+    provisional: Option<(Candidate, Option<Held>, bool)>,
     /// The STILL run last checked for a longer action in progress, and the answer.
     hold: Option<(u32, bool)>,
 }
@@ -201,10 +203,11 @@ impl<'lib> Recognizer<'lib> {
                 };
                 if let Decision::Commit(c) = self.decider.stillness(still, longer) {
                     self.commit(c, &mut emit);
-                } else if let Some(p) = self.decider.pending().filter(|_| longer) {
-                    // Held for a longer action that may yet take it over: reported now, and
-                    // revised if it is.
-                    if self.decider.stillness(still, false) != Decision::Wait {
+                } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
+                    // Held for a longer action that may yet take it over, or for the next
+                    // cycle of a cyclic one: reported after the usual pause, and revised if
+                    // it is taken over or goes on.
+                    if still >= PAUSE_US {
                         self.report_provisional(p, &mut emit);
                     }
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
@@ -389,38 +392,53 @@ impl<'lib> Recognizer<'lib> {
         best
     }
 
-    /// Reports the pending candidate `p` before it is committed (once), unless it would
-    /// continue the held event: the figurine has paused after it for as long as commits it,
-    /// and only a longer action in progress keeps it pending. The commit then revises the
-    /// report if that longer action took over (see [`ActionEvent::revises`]); a consumer has
-    /// the likely answer after the usual pause instead of after the hold.
+    /// Reports the pending candidate `p` before it is committed (once): the figurine has
+    /// paused after it for as long as commits an action, and only a longer action in progress
+    /// or the next cycle of a cyclic one could still change it. A consumer has the likely
+    /// answer after the usual pause instead of after the hold; the commit revises the report
+    /// if it did change (see [`ActionEvent::revises`]).
     fn report_provisional(&mut self, p: Candidate, emit: &mut impl FnMut(ActionEvent)) {
-        if self.provisional.is_some() || self.continues_held(&p) {
+        if self.provisional.is_some() {
             return;
         }
-        if let Some(h) = self.event_of(&p) {
-            self.provisional = Some(p);
-            self.held = None;
-            self.emit_held(h, false, emit);
+        let before = self.held;
+        if let Some((ev, continues, held)) = self.outcome(&p, before) {
+            self.provisional = Some((p, before, continues));
+            self.held = held;
+            self.emit_held(ev, continues, emit);
         }
     }
 
-    /// Whether `c` would continue the held cyclic event: same action, nothing but stillness
-    /// and a few unmatched strokes (the edges of the cycles) between them.
-    fn continues_held(&self, c: &Candidate) -> bool {
-        let hist = self.front.history();
-        self.held.is_some_and(|h| {
-            let mut i = h.end_run.wrapping_add(1);
-            let mut moving = 0usize;
-            for _ in 0..HISTORY_RUNS {
-                if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
-                    break;
-                }
-                moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
-                i = i.wrapping_add(1);
+    /// What committing `c` after the held event `held` emits — the event, and whether it
+    /// continues (revises) `held` — and the held event after it. None when `c` is too brief.
+    fn outcome(&self, c: &Candidate, held: Option<Held>) -> Option<(Held, bool, Option<Held>)> {
+        let ev = self.event_of(c)?;
+        match held.filter(|h| self.continues(h, c)) {
+            Some(mut h) => {
+                h.end = ev.end;
+                h.end_run = c.end;
+                h.distance = h.distance.max(c.distance);
+                h.acc.merge(&ev.acc);
+                Some((h, true, Some(h)))
             }
-            h.action == c.action && moving <= CONTINUE_GAP_RUNS
-        })
+            None => Some((ev, false, c.cyclic.then_some(ev))),
+        }
+    }
+
+    /// Whether `c` continues the cyclic event `h`: same action, nothing but stillness and a
+    /// few unmatched strokes (the edges of the cycles) between them.
+    fn continues(&self, h: &Held, c: &Candidate) -> bool {
+        let hist = self.front.history();
+        let mut i = h.end_run.wrapping_add(1);
+        let mut moving = 0usize;
+        for _ in 0..HISTORY_RUNS {
+            if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
+                break;
+            }
+            moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
+            i = i.wrapping_add(1);
+        }
+        h.action == c.action && moving <= CONTINUE_GAP_RUNS
     }
 
     /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).
@@ -476,32 +494,39 @@ impl<'lib> Recognizer<'lib> {
     /// report of another candidate it took over (nothing, when it is that reported candidate).
     /// A cyclic action's event stays held so that its next cycle can continue it.
     fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
-        let ev = self.event_of(&c);
-        let continues = self.continues_held(&c);
+        // After a provisional report, `c` is judged against what the consumer had before it:
+        // the held event as it was, if the report continued it; nothing, if the report was a
+        // new event (which `c` replaces).
         let provisional = self.provisional.take();
+        let before = match provisional {
+            Some((_, held, true)) => held,
+            Some((_, _, false)) => None,
+            None => self.held,
+        };
+        let out = self.outcome(&c, before);
         self.bank.reset();
         self.decider.clear();
         self.floor = c.end.wrapping_add(1);
-        // Its runs are consumed either way; a too-brief one is not emitted.
-        let Some(ev) = ev else { return };
-        if let Some(pv) = provisional {
-            self.held = c.cyclic.then_some(ev);
-            if pv != c {
-                self.emit_held(ev, true, emit);
+        // Its runs are consumed either way; a too-brief one is not emitted (and a report of
+        // another candidate stands).
+        let Some((ev, revises, held)) = out else {
+            return;
+        };
+        self.held = held;
+        match provisional {
+            // Reported already, exactly so.
+            Some((pv, _, _)) if pv == c => {}
+            // The report extended the held event: put that back, then `c`.
+            Some((_, before, true)) => {
+                if let Some(b) = before {
+                    self.emit_held(b, true, emit);
+                }
+                self.emit_held(ev, revises, emit);
             }
-            return;
+            // The report was a new event: `c` replaces it.
+            Some((_, _, false)) => self.emit_held(ev, true, emit),
+            None => self.emit_held(ev, revises, emit),
         }
-        if let Some(mut h) = self.held.filter(|_| continues) {
-            h.end = ev.end;
-            h.end_run = c.end;
-            h.distance = h.distance.max(c.distance);
-            h.acc.merge(&ev.acc);
-            self.held = Some(h);
-            self.emit_held(h, true, emit);
-            return;
-        }
-        self.held = c.cyclic.then_some(ev);
-        self.emit_held(ev, false, emit);
     }
 }
 
@@ -647,8 +672,13 @@ mod tests {
             assert!(w[1].end_us > w[0].end_us + 500_000);
             assert!(w[1].decided_us > w[0].decided_us);
         }
-        // The first cycle is reported without waiting for the others.
+        // The first cycle is reported without waiting for the others, after the usual pause
+        // rather than the longer one that commits a cycle.
         assert!(ev[0].decided_us < ev[1].end_us);
+        assert!(
+            ev[0].decided_us - ev[0].end_us < crate::segment::CYCLIC_PAUSE_US,
+            "{ev:?}"
+        );
     }
 
     #[test]

@@ -20,8 +20,9 @@ pub const LOOKAHEAD_TOKENS: u8 = 4;
 /// Stillness after a candidate that commits it, µs.
 pub const PAUSE_US: u64 = 120_000;
 /// Stillness that commits a cyclic action (whose pattern repeats as a whole), µs: a walk
-/// pauses briefly between hops without ending.
-pub const CYCLIC_PAUSE_US: u64 = 260_000;
+/// pauses briefly between hops without ending. (The recognizer reports it provisionally
+/// after [`PAUSE_US`] already, so this costs no latency.)
+pub const CYCLIC_PAUSE_US: u64 = 400_000;
 /// Stillness after a cyclic action's event up to which its next cycle continues that event
 /// (instead of starting a new one), µs.
 pub const CONTINUE_US: u64 = 500_000;

@@ -372,11 +372,18 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     };
     let periodic =
         (2..=once.len() / 2).any(|p| (0..once.len() - p).all(|i| key(once[i]) == key(once[i + p])));
+    // … or when some performance is two near-copies of one part (by translation, as above):
+    // its halves differ by at most one run.
+    let halves = |s: &Tokenized| {
+        let m: Vec<Token> = mand_of(s).into_iter().map(key).collect();
+        m.len() >= 4 && (2..=m.len() - 2).any(|p| edit_distance(&m[..p], &m[p..]) <= 1)
+    };
     let cyclic = periodic
         || seqs.iter().any(|s| {
             let m = mand_of(s);
             edit_distance(&m, &twice) < edit_distance(&m, &once)
-        });
+        })
+        || seqs.iter().any(|s| halves(s));
     seqs.swap(0, best);
     let reference = seqs[0];
     let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
@@ -831,6 +838,23 @@ mod tests {
         ];
         let re = learn_regex(&seqs).unwrap();
         assert!(re.to_source().contains("l+"), "{}", re.to_source());
+    }
+
+    #[test]
+    fn a_performance_made_of_two_near_copies_makes_the_action_cyclic() {
+        // Every example already holds two hops, each a little differently: no exact period,
+        // and none is closer to the reference done twice — but each is two near-copies.
+        let seqs = vec![
+            seq("uf:0.3 df:0.3 f:0.3 uf:0.3 df:0.3"),
+            seq("uf:0.3 df:0.3 uf:0.3 df:0.3 f:0.3"),
+            seq("uf:0.3 f:0.3 df:0.3 uf:0.3 df:0.3"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(re.compile().unwrap().cyclic, "{}", re.to_source());
+        // A back-and-forth stroke is no cycle: three runs cannot hold two copies.
+        let seqs = vec![seq("b:0.3 f:0.3 b:0.3"), seq("b:0.3 f:0.3 b:0.3")];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(!re.compile().unwrap().cyclic, "{}", re.to_source());
     }
 
     #[test]
