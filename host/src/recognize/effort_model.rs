@@ -34,7 +34,7 @@ pub fn feature_name(i: usize) -> String {
 /// One selected feature with its class-conditional Gaussians (log-domain feature values).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FeatureParams {
-    /// Feature index (0..50).
+    /// Feature index (0..54).
     pub index: u8,
     /// Feature name.
     pub name: String,

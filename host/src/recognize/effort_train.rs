@@ -53,7 +53,7 @@ pub struct TrainEffortArgs {
 /// One labelled example: features and (sudden?, strong?).
 #[derive(Debug, Clone)]
 pub struct Example {
-    /// The 50 log-domain features.
+    /// The 54 log-domain features.
     pub f: [f32; FEATURES],
     /// Sudden (true) or sustained.
     pub sudden: bool,

@@ -7,7 +7,16 @@ use anyhow::{Context, Result};
 use figurine_recognizer::features::FEATURES;
 use image::{Rgb, RgbImage};
 
+use super::effort_model::ClassifierKind;
 use super::effort_train::{Example, Trained};
+
+/// Short name of a classifier for the report.
+fn classifier(k: ClassifierKind) -> &'static str {
+    match k {
+        ClassifierKind::NaiveBayes => "NB",
+        ClassifierKind::Linear => "LDA",
+    }
+}
 use crate::raster::{draw_text, fill_rect, line};
 
 const W: u32 = 960;
@@ -46,7 +55,7 @@ fn bars(
         img,
         x,
         y + h + 16,
-        "FEATURE (0-24 MEAN, 25-49 STD), COLOURED = SELECTED",
+        "FEATURE (0-26 MEAN, 27-53 CV), COLOURED = SELECTED",
         1,
         INK,
     );
@@ -240,8 +249,10 @@ pub fn effort_report(path: &Path, ex: &[Example], t: &Trained) -> Result<()> {
         40,
         620,
         &format!(
-            "TIME M={}   WEIGHT M={}",
+            "TIME {} M={}   WEIGHT {} M={}",
+            classifier(t.file.time.classifier),
             t.file.time.features.len(),
+            classifier(t.file.weight.classifier),
             t.file.weight.features.len()
         ),
         2,
