@@ -444,8 +444,14 @@ impl<'lib> Recognizer<'lib> {
     /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).
     fn event_of(&self, c: &Candidate) -> Option<Held> {
         let hist = self.front.history();
-        let start = hist.get(c.start).map(|r| r.start);
-        let end = hist.get(c.end).map(|r| r.end);
+        let start = hist.get(c.start)?.start;
+        let end = hist.get(c.end)?.end;
+        if end.1.saturating_sub(start.1) < MIN_ACTION_US {
+            // A flicker of a token or two that happens to spell a short pattern: no child's
+            // gesture is this brief. (Checked first: a pending candidate may be asked about
+            // on every sample of a pause.)
+            return None;
+        }
         // Effort is read over the whole motion phrase around the match — out to the stillness
         // on either side (not before the previous commit) — as in training, where a gesture's
         // features span all of its motion.
@@ -473,12 +479,6 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         let acc = hist.accum(from, to);
-        let (start, end) = (start?, end?);
-        if end.1.saturating_sub(start.1) < MIN_ACTION_US {
-            // A flicker of a token or two that happens to spell a short pattern: no child's
-            // gesture is this brief.
-            return None;
-        }
         Some(Held {
             action: c.action,
             start,
