@@ -92,12 +92,19 @@ pub fn read_events<R: Read>(reader: R, name: &Path) -> Result<Vec<ActionRecord>,
                 reason: format!("bad segment times start={} end={}", rec.start, rec.end),
             });
         }
-        match out.last_mut() {
-            Some(last) if revises => *last = rec,
-            _ => out.push(rec),
-        }
+        fold_revision(&mut out, rec, revises);
     }
     Ok(out)
+}
+
+/// Appends `item` to a list of actions, or — when it `revises` the last one (a device's
+/// `Revised`, a `"revises":true` line) — puts it in that one's place. Every reader of event
+/// streams folds revisions this one way.
+pub fn fold_revision<T>(list: &mut Vec<T>, item: T, revises: bool) {
+    match list.last_mut() {
+        Some(last) if revises => *last = item,
+        _ => list.push(item),
+    }
 }
 
 /// One line of an event stream: an action, possibly revising the previous one.

@@ -428,6 +428,9 @@ impl<'lib> Recognizer<'lib> {
     /// Whether `c` continues the cyclic event `h`: same action, nothing but stillness and a
     /// few unmatched strokes (the edges of the cycles) between them.
     fn continues(&self, h: &Held, c: &Candidate) -> bool {
+        if h.action != c.action {
+            return false;
+        }
         let hist = self.front.history();
         let mut i = h.end_run.wrapping_add(1);
         let mut moving = 0usize;
@@ -438,7 +441,7 @@ impl<'lib> Recognizer<'lib> {
             moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
             i = i.wrapping_add(1);
         }
-        h.action == c.action && moving <= CONTINUE_GAP_RUNS
+        moving <= CONTINUE_GAP_RUNS
     }
 
     /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).

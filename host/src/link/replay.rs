@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use figurine_protocol::{ActionEvent, HostToDevice, Pose, Stats};
 
 use super::{Device, LinkError};
-use crate::events::ActionRecord;
+use crate::events::{fold_revision, ActionRecord};
 use crate::poselog::PoseLog;
 
 /// Unacknowledged pose batches allowed on the link.
@@ -127,16 +127,12 @@ pub fn replay_log(
                 let rec = to_record(&r.event, names, log, last_sent);
                 on_event(&rec, r.revises);
                 out.revised += u32::from(r.revises);
-                match (r.revises, out.records.last_mut(), out.events.last_mut()) {
-                    (true, Some(last_rec), Some(last_ev)) if last_ev.0.seq == r.event.seq => {
-                        *last_rec = rec;
-                        *last_ev = (r.event, r.at);
-                    }
-                    _ => {
-                        out.records.push(rec);
-                        out.events.push((r.event, r.at));
-                    }
-                }
+                // Only the event it names (same counter) is revised: after a lost message,
+                // a revision stands as an event of its own.
+                let revises =
+                    r.revises && out.events.last().is_some_and(|(e, _)| e.seq == r.event.seq);
+                fold_revision(&mut out.records, rec, revises);
+                fold_revision(&mut out.events, (r.event, r.at), revises);
             }
             Ok(())
         };

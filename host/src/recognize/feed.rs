@@ -12,6 +12,7 @@ use figurine_recognizer::history::Run;
 use figurine_recognizer::token::STILL;
 use figurine_recognizer::{ActionEvent, Recognizer, Sample};
 
+use crate::events::fold_revision;
 use crate::poselog::PoseLog;
 
 /// Turns log samples into device samples, as the link would deliver them.
@@ -91,18 +92,10 @@ impl Clock {
 pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> Vec<ActionEvent> {
     let mut events = Vec::new();
     for (_, s) in samples {
-        rec.push(s, |e| fold_event(&mut events, e));
+        rec.push(s, |e| fold_revision(&mut events, e, e.revises));
     }
-    rec.flush(|e| fold_event(&mut events, e));
+    rec.flush(|e| fold_revision(&mut events, e, e.revises));
     events
-}
-
-/// Appends `e` to `events`, or replaces the last event with it when `e` revises it.
-pub fn fold_event(events: &mut Vec<ActionEvent>, e: ActionEvent) {
-    match events.last_mut() {
-        Some(last) if e.revises => *last = e,
-        _ => events.push(e),
-    }
 }
 
 /// All token runs of a log (STILL included), in order, with their feature sums.
