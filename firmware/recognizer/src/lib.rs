@@ -9,7 +9,9 @@
 //! Stages, one module each, in data-flow order:
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
-//! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision) →
+//! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision;
+//! candidates ranked by [`alignment`]'s weighted edit distance, stand-alone gestures no
+//! action matched given to their [`nearest`] action) →
 //! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
@@ -23,6 +25,8 @@
 //! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.7 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
+//! | [`alignment::MAX_COST`] | 23 half-edits | 192 B of stack while a candidate is weighed |
+//! | [`nearest::NEAREST_MAX_TOKENS`] | 24 tokens per stand-alone phrase | 96 B of stack |
 //!
 //! Latency: the filter adds 50 ms; an action is reported [`segment::PAUSE_US`] after the
 //! figurine stops, or [`segment::LOOKAHEAD_TOKENS`] tokens after it ends when actions follow
@@ -35,6 +39,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod alignment;
 pub mod automaton;
 pub mod bayes;
 pub mod features;
@@ -44,6 +49,7 @@ pub mod frame;
 pub mod frontend;
 pub mod history;
 pub mod intake;
+pub mod nearest;
 pub mod pattern;
 pub mod recognizer;
 pub mod segment;

@@ -7,16 +7,18 @@
 //! provisional report 0.5 KiB — 13.3 KiB in all (13,648 B by `size_of`, measured by a test)
 //! with 32 actions loaded.
 
+use crate::alignment::{weighted_cost, FULL};
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
+use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, HOLD_BACK_TOKENS,
-    HOLD_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
+    INEXACT_HOLD_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -100,6 +102,9 @@ pub struct Recognizer<'lib> {
     provisional: Option<(Candidate, Option<Held>, bool)>,
     /// The STILL run last checked for a longer action in progress, and the answer.
     hold: Option<(u32, bool)>,
+    /// The STILL run after which the phrase before it was last offered to [`nearest_action`],
+    /// and the answer (None once acted on).
+    nearest: Option<(u32, Option<Nearest>)>,
 }
 
 impl<'lib> Recognizer<'lib> {
@@ -119,6 +124,7 @@ impl<'lib> Recognizer<'lib> {
             held: None,
             provisional: None,
             hold: None,
+            nearest: None,
         }
     }
 
@@ -189,7 +195,7 @@ impl<'lib> Recognizer<'lib> {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
                 let longer = match (self.decider.pending(), newest) {
-                    (Some(p), Some(run)) if (PAUSE_US..HOLD_US).contains(&still) => {
+                    (Some(p), Some(run)) if (PAUSE_US..INEXACT_HOLD_US).contains(&still) => {
                         match self.hold {
                             Some((r, v)) if r == run => v,
                             _ => {
@@ -212,6 +218,33 @@ impl<'lib> Recognizer<'lib> {
                     }
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
+                }
+                // A stand-alone gesture no action matched closely enough: its nearest action,
+                // if near (once per pause).
+                let idle = self.decider.pending().is_none() && self.provisional.is_none();
+                if let (true, true, Some(run)) = (still >= PAUSE_US, idle, newest) {
+                    let found = match self.nearest {
+                        Some((r, n)) if r == run => n,
+                        _ => {
+                            let hist = self.front.history();
+                            let n = nearest_action(
+                                &self.library,
+                                hist,
+                                self.floor,
+                                run.wrapping_sub(1),
+                            );
+                            self.nearest = Some((run, n));
+                            n
+                        }
+                    };
+                    if let Some(Nearest {
+                        candidate: Some(c),
+                        open: false,
+                    }) = found
+                    {
+                        self.nearest = Some((run, None));
+                        self.commit(c, &mut emit);
+                    }
                 }
                 if still >= CONTINUE_US {
                     self.held = None;
@@ -342,7 +375,8 @@ impl<'lib> Recognizer<'lib> {
     }
 
     fn best_candidate(&self, end: u32, m: &Matches) -> Option<Candidate> {
-        // The non-STILL runs from `end` back to the floor, newest first.
+        // The non-STILL runs from `end` back to the floor, newest at the end of `tok`, so
+        // that a match's tokens are one slice in reading order.
         let hist: &History = self.front.history();
         let mut idx = [0u32; HISTORY_RUNS];
         let mut tok = [STILL; HISTORY_RUNS];
@@ -354,7 +388,10 @@ impl<'lib> Recognizer<'lib> {
             }
             let Some(r) = hist.get(i) else { break };
             if r.token != STILL {
-                if let (Some(x), Some(t)) = (idx.get_mut(n), tok.get_mut(n)) {
+                if let (Some(x), Some(t)) = (
+                    idx.get_mut(n),
+                    tok.get_mut(HISTORY_RUNS.wrapping_sub(1 + n)),
+                ) {
                     *x = i;
                     *t = r.token;
                     n += 1;
@@ -362,6 +399,14 @@ impl<'lib> Recognizer<'lib> {
             }
             i = i.wrapping_sub(1);
         }
+        // Token `j` back from the newest.
+        let back = |j: usize| {
+            if j < n {
+                tok.get(HISTORY_RUNS.wrapping_sub(1 + j)).copied()
+            } else {
+                None
+            }
+        };
         let mut best: Option<Candidate> = None;
         for (a, &d) in m.iter().enumerate() {
             if d == u8::MAX {
@@ -370,16 +415,29 @@ impl<'lib> Recognizer<'lib> {
             let Some(p) = self.library.pattern(a) else {
                 continue;
             };
-            let found = earliest_start(&p, d, |j| if j < n { tok.get(j).copied() } else { None });
+            let found = earliest_start(&p, d, back);
             let Some((j, k)) = found else { continue };
-            if !edits_fit(k, j + 1) {
+            if !edits_fit(k, (j + 1).max(p.min_len())) {
                 continue;
             }
+            // Each edit costs at least HALF: skip what cannot beat the best so far.
+            let len = (j + 1) as i32;
+            if best.is_some_and(|b| 4 * len - 3 * i32::from(k) < b.merit()) {
+                continue;
+            }
+            // The match is the last j + 1 tokens; an exact one costs nothing.
+            let cost = if k == 0 {
+                0
+            } else {
+                let span = tok.get(HISTORY_RUNS.wrapping_sub(1 + j)..).unwrap_or(&[]);
+                weighted_cost(&p, span, FULL * k).unwrap_or(FULL * k)
+            };
             let c = Candidate {
                 action: a as u8,
                 start: idx.get(j).copied().unwrap_or(end),
                 end,
                 distance: k,
+                cost,
                 len: (j + 1) as u16,
                 min_len: p.min_len().min(255) as u8,
                 positions: p.positions().min(255) as u8,
@@ -609,6 +667,24 @@ mod tests {
             [1],
             "{ev:?}"
         );
+    }
+
+    #[test]
+    fn a_stand_alone_gesture_past_every_bound_is_its_nearest_action() {
+        // The hop (`uf f df`) against `u+ f+ d+` with no edits allowed: 45° off twice, half an
+        // edit each — too far for the automaton, near enough once the hop stands alone.
+        let blob = seq_library(&[(&["l", "r"], 0), (&["u", "f", "d"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &hops(1, 0));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert_eq!((ev[0].action, ev[0].distance), (1, 1));
+        // Decided after the pause that commits any action.
+        let after = ev[0].decided_us - ev[0].end_us;
+        assert!((PAUSE_US..PAUSE_US + 100_000).contains(&after), "{after}");
+        // Nothing near: nothing reported.
+        let blob = seq_library(&[(&["l", "r"], 0), (&["b", "d"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        assert_eq!(run(&lib, &hops(1, 0)), []);
     }
 
     /// `hops` hops forward (as [`hops`]), each pair of hops separated by `pause_s` of stillness.

@@ -2,18 +2,23 @@
 //!
 //! Each token that completes one or more approximate matches yields candidates (action, first
 //! and last run, distance, length in tokens). A pending candidate is replaced by an overlapping
-//! one of higher merit `2·length − 3·distance` — near-ties go to the longest action, as in
-//! seed 000 §7.5, and an action that keeps extending (a walk of several hops) grows instead of
-//! being cut. The pending candidate is committed when
+//! one of higher merit `4·length − 3·cost`, the cost in half-edits
+//! ([`crate::alignment::weighted_cost`]: a token that differs from the pattern only in its
+//! rotation, or by 45° in its direction, costs half an edit) — near-ties go to the longest
+//! action, as in seed 000 §7.5, and an action that keeps extending (a walk of several hops)
+//! grows instead of being cut. The pending candidate is committed when
 //! - a candidate appears that starts after it (the next action has begun),
 //! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
 //! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
-//!   whose pattern repeats as a whole; up to [`HOLD_US`] while another action has matched
-//!   further than it exactly and may go on after the hold), or
+//!   whose pattern repeats as a whole; up to [`HOLD_US`] — [`INEXACT_HOLD_US`] when it
+//!   needed edits — while another action has matched further than it exactly and may go on
+//!   after the hold), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
-//! the look-ahead are replayed), so segments never overlap.
+//! the look-ahead are replayed), so segments never overlap. A gesture that stands alone and
+//! that no action matched within its bound is offered to [`crate::nearest`] once the figurine
+//! has paused after it.
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
 pub const LOOKAHEAD_TOKENS: u8 = 4;
@@ -32,6 +37,10 @@ pub const CONTINUE_GAP_RUNS: usize = 2;
 /// Stillness inside a longer action that does not yet commit a shorter pending one, µs: a
 /// punch held at full reach, a crouch held low.
 pub const HOLD_US: u64 = 500_000;
+/// [`HOLD_US`] for a pending candidate that needed edits, µs: while an action that matched
+/// further exactly may go on, an inexact match is the weaker reading of a long hold (a crouch
+/// held low, whose downward strokes a jump also explains by leaving out its rise).
+pub const INEXACT_HOLD_US: u64 = 1_000_000;
 /// Edits a match may spend per token it covers, as (edits, tokens): 2 per 5. A pattern's own
 /// bound (up to [`crate::pattern::MAX_EDITS`]) caps the total; this share keeps a short match
 /// from being mostly edits, so the bound can be generous for long performances without
@@ -59,8 +68,11 @@ pub struct Candidate {
     pub start: u32,
     /// Last run (absolute history index).
     pub end: u32,
-    /// Edit distance.
+    /// Edit distance (each edit 1; what the action's bound limits).
     pub distance: u8,
+    /// Weighted edit distance in half-edits ([`crate::alignment::weighted_cost`]): a
+    /// rotation-only disagreement costs half an edit. What candidates are ranked by.
+    pub cost: u8,
     /// Non-STILL tokens covered.
     pub len: u16,
     /// Shortest match of the action's pattern (its specificity), tokens.
@@ -72,9 +84,10 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// Ranking score: longer is better, each edit costs 1.5 tokens.
+    /// Ranking score, in quarter tokens: longer is better, each edit costs 1.5 tokens
+    /// (a rotation-only disagreement half of that).
     pub fn merit(&self) -> i32 {
-        2 * i32::from(self.len) - 3 * i32::from(self.distance)
+        4 * i32::from(self.len) - 3 * i32::from(self.cost)
     }
 
     /// True when `self` should replace `other`: higher merit; at equal merit the more
@@ -163,14 +176,20 @@ impl Decider {
     }
 
     /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`] —
-    /// or after [`HOLD_US`] while `longer_in_progress` (a longer action has matched further
-    /// than the pending one and may go on after the hold).
+    /// or after [`HOLD_US`] ([`INEXACT_HOLD_US`] if the pending candidate needed edits) while
+    /// `longer_in_progress` (a longer action has matched further than the pending one and may
+    /// go on after the hold).
     pub fn stillness(&mut self, still_us: u64, longer_in_progress: bool) -> Decision {
         let Some(p) = self.pending else {
             return Decision::Wait;
         };
         let pause = if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US };
-        if still_us >= pause && (still_us >= HOLD_US || !longer_in_progress) {
+        let hold = if p.distance > 0 {
+            INEXACT_HOLD_US
+        } else {
+            HOLD_US
+        };
+        if still_us >= pause && (still_us >= hold || !longer_in_progress) {
             Decision::Commit(p)
         } else {
             Decision::Wait
@@ -188,6 +207,7 @@ mod tests {
             start,
             end,
             distance,
+            cost: 2 * distance,
             len: (end - start + 1) as u16,
             min_len: 1,
             positions: 1,
@@ -265,5 +285,35 @@ mod tests {
         d.offer(Some(c(0, 2, 3, 0)), 0);
         assert_eq!(d.stillness(PAUSE_US, true), Decision::Wait);
         assert_eq!(d.stillness(HOLD_US, true), Decision::Commit(c(0, 2, 3, 0)));
+        // An inexact pending candidate is the weaker reading of a long hold: it waits longer.
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 1, 3, 1)), 0);
+        assert_eq!(d.stillness(HOLD_US, true), Decision::Wait);
+        assert_eq!(d.stillness(INEXACT_HOLD_US - 1, true), Decision::Wait);
+        assert_eq!(
+            d.stillness(INEXACT_HOLD_US, true),
+            Decision::Commit(c(0, 1, 3, 1))
+        );
+        assert_eq!(
+            d.stillness(PAUSE_US, false),
+            Decision::Commit(c(0, 1, 3, 1))
+        );
+    }
+
+    #[test]
+    fn a_rotation_only_disagreement_ranks_above_a_missing_stroke() {
+        // The same three tokens, one edit each: a crouch reading `u.Xn` as its `u` (half an
+        // edit) beats a jump that leaves out its landing (a whole one).
+        let crouch = Candidate {
+            cost: 1,
+            min_len: 2,
+            ..c(8, 1, 3, 1)
+        };
+        let jump = Candidate {
+            min_len: 3,
+            ..c(2, 1, 3, 1)
+        };
+        assert!(crouch.merit() > jump.merit());
+        assert!(crouch.beats(&jump) && !jump.beats(&crouch));
     }
 }

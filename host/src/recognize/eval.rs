@@ -291,6 +291,12 @@ pub fn evaluate(
                         l.action,
                         super::library::tokens_to_string(&super::learn::tokens_only(&t))
                     );
+                    for e in &evs {
+                        eprintln!(
+                            "    event {} {:.2}-{:.2} (gesture {:.2}-{:.2})",
+                            e.action, e.start, e.end, l.start, l.end
+                        );
+                    }
                 }
                 *conf.entry((l.action.clone(), got)).or_default() += 1;
             }

@@ -1,0 +1,267 @@
+//! Stage 6a — how well a candidate match fits its pattern, for ranking candidates.
+//!
+//! The automata of [`crate::automaton`] count every edit as one, which is what a bound needs.
+//! Ranking two candidates that both fit their bound needs a finer measure: a token that
+//! disagrees with the pattern only about its rotation (`u.Xn` where the examples showed `u` —
+//! the toy wobbled while it rose) is a far smaller departure than a stroke that is missing or
+//! extra, because rotation modifiers come and go with how the toy is held, while strokes are
+//! the gesture. So a crouch `d.Xp u.Xn` (one rotation disagreement) ranks above a jump that
+//! explains the same tokens by leaving out its landing.
+//!
+//! [`weighted_cost`] is the edit distance between a candidate's tokens and its whole pattern
+//! with these costs, in half-edits: insertion, deletion and substitution [`FULL`]; a
+//! substitution [`HALF`] between two moving tokens that differ only in their rotation half, or
+//! only in one component of their translation direction at the same rotation (`uf` for `f`:
+//! 45° apart). Like the automata it is bit-parallel over the pattern's Glushkov states: one
+//! `u64` set per cost level, `D[v]` = the states some alignment of the tokens read so far
+//! reaches at cost ≤ v. With `B`/`H` the positions a token matches exactly / at half cost:
+//! ```text
+//! D'[v] = T(D[v]) ∩ B  ∪  T(D[v−1]) ∩ H  ∪  T(D[v−2])   match, half and full substitution
+//!       ∪ D[v−2]  ∪  D'[v−1]  ∪  T(D'[v−2])               insertion, monotone, deletion
+//! ```
+//! Levels go up to the bound the caller asks for (at most [`MAX_COST`]), so its cost is
+//! `tokens × levels` forward steps — run once per inexact candidate, never per sample.
+
+use crate::pattern::{Pattern, MAX_POSITIONS};
+use crate::token::{symbol_matches, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL};
+
+/// Cost of an insertion, a deletion or a substitution, in half-edits.
+pub const FULL: u8 = 2;
+/// Cost of a substitution between near tokens (see the module docs), half-edits.
+pub const HALF: u8 = 1;
+/// Highest cost [`weighted_cost`] resolves, half-edits (its level sets: 8 bytes each, on the
+/// stack).
+pub const MAX_COST: u8 = 23;
+
+const LEVELS: usize = MAX_COST as usize + 1;
+
+/// Per translation code (0..27), the codes one component away from it (45° apart; none for
+/// the empty translation): `NEIGHBOURS[a] >> b & 1`.
+const NEIGHBOURS: [u32; 27] = {
+    let mut out = [0u32; 27];
+    let mut a = 0;
+    while a < 27 {
+        let mut b = 0;
+        while b < 27 {
+            let (mut apart, mut k, mut x, mut y) = (0, 0, a, b);
+            while k < 3 {
+                let d = (x % 3) as i32 - (y % 3) as i32;
+                apart += if d < 0 { -d } else { d };
+                x /= 3;
+                y /= 3;
+                k += 1;
+            }
+            if apart == 1 && a != NONE_BIN as usize && b != NONE_BIN as usize {
+                out[a] |= 1 << b;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    out
+};
+
+/// Whether reading token `c` at a position labelled `s` costs [`HALF`] (it does not match).
+fn near(s: Symbol, c: Token) -> bool {
+    let code = s & 0x3ff;
+    let (lin_s, lin_c) = (code / 27, c / 27);
+    if c >= STILL || s & ANY_LIN != 0 || lin_c == NONE_BIN || lin_s == NONE_BIN {
+        // Pure rotations: the rotation is the gesture.
+        return false;
+    }
+    let same_rotation = s & ANY_ROT != 0 || code % 27 == c % 27;
+    let neighbour = NEIGHBOURS
+        .get(usize::from(lin_s))
+        .is_some_and(|m| m >> lin_c & 1 != 0);
+    lin_s == lin_c || (same_rotation && neighbour)
+}
+
+/// The positions of `p` that read `c` exactly, and those that read it at [`HALF`] cost.
+fn masks(p: &Pattern<'_>, c: Token) -> (u64, u64) {
+    let (mut exact, mut half) = (0u64, 0u64);
+    for i in 1..=p.positions().min(MAX_POSITIONS) {
+        let s = p.symbol(i);
+        if symbol_matches(s, c) {
+            exact |= 1 << i;
+        } else if near(s, c) {
+            half |= 1 << i;
+        }
+    }
+    (exact, half)
+}
+
+/// Weighted edit distance (half-edits) between `tokens` (oldest first) and the whole of
+/// pattern `p`: the cheapest way to read all the tokens from the initial state to an
+/// accepting one. None when it exceeds `bound` (itself capped at [`MAX_COST`]).
+// Once per inexact candidate: out of line, one copy (flash).
+#[inline(never)]
+pub fn weighted_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8> {
+    let levels = usize::from(bound.min(MAX_COST)) + 1;
+    // Level v is updated in place, walking up; the levels below it (old and new) and their
+    // forward images ride along in these.
+    let mut d = [0u64; LEVELS];
+    // Before reading: the initial state, and the positions leading deletions reach.
+    let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
+    for (v, slot) in d.iter_mut().take(levels).enumerate() {
+        let n = if v == 0 { 1 } else { n1 } | g2;
+        *slot = n;
+        let g = p.forward(n);
+        (n1, g2, g1) = (n, g1, g);
+    }
+    for &c in tokens {
+        let (exact, half) = masks(p, c);
+        // Old levels v−1, v−2 and forward images; new level v−1 and forward images v−1, v−2.
+        let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
+        let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
+        for slot in d.iter_mut().take(levels) {
+            let o0 = *slot;
+            let f0 = p.forward(o0);
+            let n = (f0 & exact) | (f1 & half) | f2 | o2 | n1 | g2;
+            *slot = n;
+            let g = p.forward(n);
+            (o2, o1, f2, f1) = (o1, o0, f1, f0);
+            (n1, g2, g1) = (n, g1, g);
+        }
+        if n1 == 0 {
+            // Not even the top level reaches anything: over the bound.
+            return None;
+        }
+    }
+    let last = p.last();
+    d.iter()
+        .take(levels)
+        .position(|&x| x & last != 0)
+        .map(|v| v as u8)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::pattern::tests::seq_library;
+    use crate::pattern::Library;
+    use crate::token::parse_token;
+    use proptest::prelude::*;
+    use std::vec::Vec;
+
+    fn toks(s: &str) -> Vec<Token> {
+        s.split_whitespace()
+            .map(|t| parse_token(t).unwrap())
+            .collect()
+    }
+
+    /// Cost of `tokens` against the pattern `pattern[0]+ pattern[1]+ …`.
+    fn cost(pattern: &[&str], tokens: &str) -> Option<u8> {
+        let blob = seq_library(&[(pattern, 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        let t = toks(tokens);
+        weighted_cost(&p, &t, MAX_COST)
+    }
+
+    /// The same distance by a plain dynamic programme over the states (one cost per state,
+    /// deletions closed by relaxing to a fixpoint), written as plainly as possible.
+    #[allow(clippy::needless_range_loop)]
+    fn reference(p: &Pattern<'_>, tokens: &[Token]) -> u32 {
+        let n = p.positions();
+        let inf = u32::MAX / 4;
+        let close = |d: &mut Vec<u32>| loop {
+            let mut changed = false;
+            for from in 0..=n {
+                for q in 1..=n {
+                    if p.follow(from) & (1 << q) != 0 && d[from] + 2 < d[q] {
+                        d[q] = d[from] + 2;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        };
+        let mut d = std::vec![inf; n + 1];
+        d[0] = 0;
+        close(&mut d);
+        for &c in tokens {
+            let mut next: Vec<u32> = d.iter().map(|&x| x + 2).collect();
+            for from in 0..=n {
+                for q in 1..=n {
+                    if p.follow(from) & (1 << q) != 0 {
+                        let s = p.symbol(q);
+                        let sub = if symbol_matches(s, c) {
+                            0
+                        } else if near(s, c) {
+                            1
+                        } else {
+                            2
+                        };
+                        next[q] = next[q].min(d[from] + sub);
+                    }
+                }
+            }
+            close(&mut next);
+            d = next;
+        }
+        (1..=n)
+            .filter(|&q| p.last() & (1 << q) != 0)
+            .map(|q| d[q])
+            .min()
+            .unwrap_or(inf)
+    }
+
+    #[test]
+    fn exact_near_and_stroke_edits_cost_0_1_2() {
+        assert_eq!(cost(&["d", "u"], "d u"), Some(0));
+        assert_eq!(cost(&["d", "u"], "d u.Xn"), Some(HALF));
+        // 45° off at the same rotation: half; 90° off: a full substitution.
+        assert_eq!(cost(&["d", "uf"], "d f"), Some(HALF));
+        assert_eq!(cost(&["d", "u"], "d f"), Some(FULL));
+        assert_eq!(cost(&["d", "uf.Xn"], "d f"), Some(FULL));
+        // Missing landing: one deletion; an extra stroke: one insertion.
+        assert_eq!(cost(&["d", "u", "d"], "d u"), Some(FULL));
+        assert_eq!(cost(&["d", "u"], "d b u"), Some(FULL));
+        // A pure rotation's rotation is the gesture: `.Xn` for `.Xp` is a full substitution.
+        assert_eq!(cost(&[".Xp", ".Xn"], ".Xp .Xp"), Some(FULL));
+    }
+
+    #[test]
+    fn the_crouch_with_a_wobble_beats_the_jump_without_its_landing() {
+        let crouch = cost(&["d", "u"], "d.Xp u.Xn u").unwrap();
+        let jump = cost(&["d", "u", "d"], "d.Xp u.Xn u").unwrap();
+        assert!(crouch < jump, "crouch {crouch} jump {jump}");
+    }
+
+    #[test]
+    fn beyond_the_bound_is_none_and_still_tokens_are_extra() {
+        assert_eq!(cost(&["d", "u", "d"], ""), Some(3 * FULL));
+        let blob = seq_library(&[(&["d", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        assert_eq!(weighted_cost(&p, &[STILL, STILL], MAX_COST), Some(2 * FULL));
+        let t = toks("f b f b");
+        assert_eq!(weighted_cost(&p, &t, 7), None);
+        assert_eq!(weighted_cost(&p, &t, 8), Some(8));
+    }
+
+    proptest! {
+        #[test]
+        fn bit_parallel_levels_agree_with_the_plain_programme(
+            pat in proptest::collection::vec(0usize..8, 1..6),
+            text in proptest::collection::vec(0usize..8, 0..9),
+        ) {
+            const NAMES: [&str; 8] = ["u", "uf", "f", "d", "d.Xp", "f.Xn", ".Xp", "lu"];
+            let names: Vec<&str> = pat.iter().map(|&i| NAMES[i]).collect();
+            let blob = seq_library(&[(&names, 0)]);
+            let lib = Library::from_bytes(&blob).unwrap();
+            let p = lib.pattern(0).unwrap();
+            let t: Vec<Token> = text.iter().map(|&i| parse_token(NAMES[i]).unwrap()).collect();
+            let want = reference(&p, &t);
+            let got = weighted_cost(&p, &t, MAX_COST);
+            if want <= u32::from(MAX_COST) {
+                prop_assert_eq!(got, Some(want as u8));
+            } else {
+                prop_assert_eq!(got, None);
+            }
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! Stage 6b — a gesture no action matched closely enough: the nearest action, if near.
+//!
+//! The automata hold every match to its action's edit bound and to
+//! [`crate::segment::EDIT_SHARE`], which is what keeps a lone stroke inside a longer motion
+//! from being read as an action. But a gesture that stands alone — a phrase of motion with a
+//! pause of at least [`HOLD_US`] before it and [`crate::segment::PAUSE_US`] after it, nothing
+//! of it matched, and no action's pattern able to go on from it (the pause is no hold inside
+//! a gesture) — is plainly meant as one action, even when it strays from the few examples its
+//! action was learnt from further than the bound allows: a kick swung straight forward where
+//! every example rose, a punch thrown without its wind-up. A child expects the toy to answer
+//! it. Such a phrase is compared whole with every action ([`weighted_cost`]) and reported as
+//! the nearest one when it is within the share of edits every match is held to
+//! ([`EDIT_SHARE`]), without the action's own bound; otherwise nothing is reported.
+//!
+//! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
+//! gestures. Run once per pause, over at most [`NEAREST_MAX_TOKENS`] tokens; its cost is a
+//! rare spike (measured by the firmware bench), not a per-sample one.
+
+use crate::alignment::{weighted_cost, FULL};
+use crate::automaton::prefix_alive;
+use crate::history::{History, HISTORY_RUNS};
+use crate::pattern::Library;
+use crate::segment::{Candidate, EDIT_SHARE, HOLD_US};
+use crate::token::{Token, STILL};
+
+/// Longest phrase that is compared with the actions, moving tokens; a longer one is no single
+/// gesture (a single long performance matches its action within the bounds anyway).
+pub const NEAREST_MAX_TOKENS: usize = 24;
+
+/// The moving tokens of the phrase that ends at run `last` (the run before the current
+/// pause): back to the previous pause of at least [`HOLD_US`]. None when the phrase reaches
+/// back to `floor` (part of it was committed already, or matching restarted inside it) or past
+/// the history, or is longer than [`NEAREST_MAX_TOKENS`]. Returns the tokens oldest first, and
+/// the phrase's first and last moving runs.
+fn phrase(
+    hist: &History,
+    floor: u32,
+    last: u32,
+    tok: &mut [Token; NEAREST_MAX_TOKENS],
+) -> Option<(usize, u32, u32)> {
+    let mut rev = [STILL; NEAREST_MAX_TOKENS];
+    let mut n = 0usize;
+    let mut first = last;
+    let span = last.wrapping_sub(floor);
+    if span >= HISTORY_RUNS as u32 {
+        // `last` lies below the floor (it was committed), or the floor is long gone.
+        return None;
+    }
+    let mut i = last;
+    for _ in 0..HISTORY_RUNS {
+        if i.wrapping_sub(floor) > span {
+            // Below the floor: the phrase is not whole.
+            return None;
+        }
+        let r = hist.get(i)?;
+        if r.token == STILL {
+            if r.end.1.saturating_sub(r.start.1) >= HOLD_US {
+                break;
+            }
+        } else {
+            *rev.get_mut(n)? = r.token;
+            n += 1;
+            first = i;
+        }
+        i = i.wrapping_sub(1);
+    }
+    if n == 0 {
+        return None;
+    }
+    for (k, slot) in tok.iter_mut().take(n).enumerate() {
+        *slot = rev.get(n - 1 - k).copied().unwrap_or(STILL);
+    }
+    Some((n, first, last))
+}
+
+/// What [`nearest_action`] found for one pause.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Nearest {
+    /// The nearest action over the phrase, when near enough.
+    pub candidate: Option<Candidate>,
+    /// Some action's pattern has the phrase as the start of a match that is not over: the
+    /// pause may be a hold inside it, so the phrase stands alone only after [`HOLD_US`].
+    pub open: bool,
+}
+
+/// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
+/// phrase, when one is near enough ([`EDIT_SHARE`]); its `distance` is the weighted cost
+/// rounded up to whole edits. Ties of cost per aligned token go to the lower action index.
+/// None when there is no whole phrase (see [`phrase`]).
+// Once per pause at most: kept out of the per-sample path (flash, not speed).
+#[cold]
+#[inline(never)]
+pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) -> Option<Nearest> {
+    let mut tok = [STILL; NEAREST_MAX_TOKENS];
+    let (n, first, last) = phrase(hist, floor, last, &mut tok)?;
+    let tokens = tok.get(..n).unwrap_or(&[]);
+    let mut best: Option<(Candidate, usize)> = None;
+    let mut open = false;
+    for a in 0..lib.len() {
+        let Some(p) = lib.pattern(a) else { continue };
+        open |= prefix_alive(&p, tokens, false);
+        let aligned = n.max(p.min_len());
+        // Within the share: cost ≤ FULL · aligned · e / t half-edits.
+        let (e, t) = EDIT_SHARE;
+        let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
+        let Some(cost) = weighted_cost(&p, tokens, bound) else {
+            continue;
+        };
+        let c = Candidate {
+            action: a as u8,
+            start: first,
+            end: last,
+            distance: cost.div_ceil(FULL),
+            cost,
+            len: n as u16,
+            min_len: p.min_len().min(255) as u8,
+            positions: p.positions().min(255) as u8,
+            cyclic: p.cyclic(),
+        };
+        // Lower cost per aligned token: c.cost / aligned < b.cost / b_aligned.
+        let better = best.is_none_or(|(b, b_aligned)| {
+            usize::from(c.cost) * b_aligned < usize::from(b.cost) * aligned
+        });
+        if better {
+            best = Some((c, aligned));
+        }
+    }
+    Some(Nearest {
+        candidate: best.map(|(c, _)| c),
+        open,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::alignment::HALF;
+    use crate::features::Accum;
+    use crate::pattern::tests::seq_library;
+    use crate::token::parse_token;
+
+    /// A history of runs `(token, duration ms)` ("_" for STILL), back to back from t = 0.
+    fn history(runs: &[(&str, u64)]) -> History {
+        let mut h = History::new();
+        let mut t = 0u64;
+        for (i, &(name, ms)) in runs.iter().enumerate() {
+            let token = if name == "_" {
+                STILL
+            } else {
+                parse_token(name).unwrap()
+            };
+            h.open(token, (i as u32, t), Accum::new());
+            t += ms * 1000;
+            h.newest_mut().unwrap().end = (i as u32, t);
+        }
+        h
+    }
+
+    fn lib_blob() -> std::vec::Vec<u8> {
+        // 0: punch `b+ f+ b+`, 1: crouch `d+ u+`, 2: kick `uf.Xn+ b.Xp+ db+`.
+        seq_library(&[
+            (&["b", "f", "b"], 2),
+            (&["d", "u"], 1),
+            (&["uf.Xn", "b.Xp", "db"], 0),
+        ])
+    }
+
+    #[test]
+    fn a_stand_alone_gesture_is_its_nearest_action() {
+        let blob = lib_blob();
+        let lib = Library::from_bytes(&blob).unwrap();
+        // A punch without its wind-up: one deletion in three aligned tokens.
+        let h = history(&[("_", 800), ("f", 200), ("b", 200), ("_", 150)]);
+        let n = nearest_action(&lib, &h, 0, 2).unwrap();
+        let c = n.candidate.unwrap();
+        assert_eq!(
+            (c.action, c.start, c.end, c.distance, c.cost),
+            (0, 1, 2, 1, FULL)
+        );
+        assert!(!n.open);
+        // A kick swung straight forward (`f.Xn`, 45° below `uf.Xn`), past its bound of 0.
+        let h = history(&[
+            ("_", 800),
+            ("f.Xn", 200),
+            ("b.Xp", 200),
+            ("db", 200),
+            ("_", 150),
+        ]);
+        let c = nearest_action(&lib, &h, 0, 3).unwrap().candidate.unwrap();
+        assert_eq!((c.action, c.cost, c.distance), (2, HALF, 1));
+        // Without its drop back as well, it is too far: 1.5 edits in 3 aligned tokens.
+        let h = history(&[("_", 800), ("f.Xn", 200), ("b.Xp", 200), ("_", 150)]);
+        assert_eq!(nearest_action(&lib, &h, 0, 2).unwrap().candidate, None);
+    }
+
+    #[test]
+    fn far_phrases_pieces_and_prefixes_are_not_reported() {
+        let blob = lib_blob();
+        let lib = Library::from_bytes(&blob).unwrap();
+        // Nothing like any action.
+        let h = history(&[("_", 800), ("l", 200), ("r", 200), ("l", 200), ("_", 150)]);
+        assert_eq!(nearest_action(&lib, &h, 0, 3).unwrap().candidate, None);
+        // A crouch's way down, held: the crouch may still rise.
+        let h = history(&[("_", 800), ("d", 300), ("_", 150)]);
+        assert!(nearest_action(&lib, &h, 0, 1).unwrap().open);
+        // A pause shorter than a hold lies inside the phrase, which reaches the floor there.
+        let h = history(&[
+            ("_", 800),
+            ("b", 200),
+            ("f", 200),
+            ("_", 300),
+            ("b", 200),
+            ("_", 150),
+        ]);
+        assert_eq!(nearest_action(&lib, &h, 3, 4), None);
+        let c = nearest_action(&lib, &h, 0, 4).unwrap().candidate.unwrap();
+        assert_eq!((c.action, c.start, c.end, c.cost), (0, 1, 4, 0));
+        // The last run below the floor (committed), or no motion at all.
+        assert_eq!(nearest_action(&lib, &h, 5, 4), None);
+        let h = history(&[("_", 800), ("_", 150)]);
+        assert_eq!(nearest_action(&lib, &h, 0, 0), None);
+    }
+
+    #[test]
+    fn a_phrase_longer_than_the_capacity_is_not_compared() {
+        let blob = lib_blob();
+        let lib = Library::from_bytes(&blob).unwrap();
+        let mut runs = std::vec![("_", 800)];
+        runs.extend(core::iter::repeat_n(("f", 50), NEAREST_MAX_TOKENS + 1));
+        runs.push(("_", 150));
+        let h = history(&runs);
+        assert_eq!(
+            nearest_action(&lib, &h, 0, (NEAREST_MAX_TOKENS + 1) as u32),
+            None
+        );
+    }
+}
