@@ -23,7 +23,7 @@
 //! `tokens × levels` forward steps — run once per inexact candidate, never per sample.
 
 use crate::pattern::{Pattern, MAX_POSITIONS};
-use crate::token::{symbol_matches, Symbol, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL};
+use crate::token::{symbol_matches, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL};
 
 /// Cost of an insertion, a deletion or a substitution, in half-edits.
 pub const FULL: u8 = 2;
@@ -61,30 +61,32 @@ const NEIGHBOURS: [u32; 27] = {
     out
 };
 
-/// Whether reading token `c` at a position labelled `s` costs [`HALF`] (it does not match).
-fn near(s: Symbol, c: Token) -> bool {
-    let code = s & 0x3ff;
-    let (lin_s, lin_c) = (code / 27, c / 27);
-    if c >= STILL || s & ANY_LIN != 0 || lin_c == NONE_BIN || lin_s == NONE_BIN {
-        // Pure rotations: the rotation is the gesture.
-        return false;
+/// The positions of `p` that read token `c` exactly, and those that read it at [`HALF`] cost:
+/// for a moving `c`, positions of the same translation (any rotation), and positions one
+/// direction component away at the same rotation. Pure rotations have no near tokens: their
+/// rotation is the gesture.
+pub(crate) fn masks(p: &Pattern<'_>, c: Token) -> (u64, u64) {
+    if c >= STILL {
+        return (0, 0);
     }
-    let same_rotation = s & ANY_ROT != 0 || code % 27 == c % 27;
-    let neighbour = NEIGHBOURS
-        .get(usize::from(lin_s))
-        .is_some_and(|m| m >> lin_c & 1 != 0);
-    lin_s == lin_c || (same_rotation && neighbour)
-}
-
-/// The positions of `p` that read `c` exactly, and those that read it at [`HALF`] cost.
-fn masks(p: &Pattern<'_>, c: Token) -> (u64, u64) {
+    let (lin_c, rot_c) = (c / 27, c % 27);
+    let neighbours = if lin_c == NONE_BIN {
+        None
+    } else {
+        NEIGHBOURS.get(usize::from(lin_c)).copied()
+    };
     let (mut exact, mut half) = (0u64, 0u64);
-    for i in 1..=p.positions().min(MAX_POSITIONS) {
-        let s = p.symbol(i);
+    for (i, s) in p.symbols().enumerate().take(MAX_POSITIONS) {
+        let bit = 2u64 << i;
+        let code = s & 0x3ff;
+        let (lin_s, rot_s) = (code / 27, code % 27);
         if symbol_matches(s, c) {
-            exact |= 1 << i;
-        } else if near(s, c) {
-            half |= 1 << i;
+            exact |= bit;
+        } else if let Some(nb) = neighbours.filter(|_| s & ANY_LIN == 0) {
+            let same_rotation = s & ANY_ROT != 0 || rot_s == rot_c;
+            if lin_s == lin_c || (same_rotation && nb >> lin_s & 1 != 0) {
+                half |= bit;
+            }
         }
     }
     (exact, half)
@@ -140,7 +142,7 @@ mod tests {
     use super::*;
     use crate::pattern::tests::seq_library;
     use crate::pattern::Library;
-    use crate::token::parse_token;
+    use crate::token::{parse_token, token_signs, Symbol};
     use proptest::prelude::*;
     use std::vec::Vec;
 
@@ -157,6 +159,21 @@ mod tests {
         let p = lib.pattern(0).unwrap();
         let t = toks(tokens);
         weighted_cost(&p, &t, MAX_COST)
+    }
+
+    /// Whether `c` at a position labelled `s` is a near substitution, from the token's sign
+    /// triples (independently of the table `masks` uses).
+    fn near_ref(s: Symbol, c: Token) -> bool {
+        let code = s & 0x3ff;
+        let (lin_s, lin_c) = (code / 27, c / 27);
+        if c >= STILL || s & ANY_LIN != 0 || lin_c == NONE_BIN || lin_s == NONE_BIN {
+            return false;
+        }
+        let same_rotation = s & ANY_ROT != 0 || code % 27 == c % 27;
+        let (a, _) = token_signs(code);
+        let (b, _) = token_signs(c);
+        let apart: u8 = a.iter().zip(b.iter()).map(|(x, y)| x.abs_diff(*y)).sum();
+        lin_s == lin_c || (same_rotation && apart == 1)
     }
 
     /// The same distance by a plain dynamic programme over the states (one cost per state,
@@ -190,7 +207,7 @@ mod tests {
                         let s = p.symbol(q);
                         let sub = if symbol_matches(s, c) {
                             0
-                        } else if near(s, c) {
+                        } else if near_ref(s, c) {
                             1
                         } else {
                             2

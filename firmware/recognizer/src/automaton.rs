@@ -1,29 +1,37 @@
-//! Stage 5 — fixed-size Levenshtein automata: every action matched in parallel.
+//! Stage 5 — fixed-size weighted Levenshtein automata: every action matched in parallel.
 //!
-//! For each action, `max_edits + 1` state masks (one `u64` per edit level, bit-parallel over
-//! the Glushkov positions of [`crate::pattern`]) track every way the recent token stream can
-//! end inside the pattern with ≤ k edits. The initial state is always active, so a match may
-//! start anywhere; the cost per token is a handful of word operations per level, independent
-//! of how long the figurine has been played with. With tokens `c` and `B[c]` the positions
-//! labelled `c`, level k is updated as
+//! Edits are counted in half-edits ([`crate::alignment`]): an insertion, a deletion or a
+//! substitution costs [`FULL`] = 2; a substitution between near tokens (the same stroke with
+//! another rotation, or a stroke 45° off at the same rotation) costs [`HALF`](crate::alignment::HALF) = 1. For each
+//! action, `2·max_edits + 1` state masks (one `u64` per cost level, bit-parallel over the
+//! Glushkov positions of [`crate::pattern`]) track every way the recent token stream can end
+//! inside the pattern at cost ≤ v. The initial state is always active, so a match may start
+//! anywhere; the cost per token is a handful of word operations per level, independent of how
+//! long the figurine has been played with. With `T` the forward transition, `B`/`H` the
+//! positions that read token `c` exactly / at half cost, and `Iᵥ` the start and the positions
+//! leading deletions of cost ≤ v reach, level v is updated as
 //! ```text
-//! D'[0] = T(D[0] ∪ {0}) ∩ B[c]
-//! D'[k] = T(D[k] ∪ Iₖ) ∩ B[c]      match (Iₖ: the start and the positions k deletions from it)
-//!       ∪ D[k−1]                    insertion (extra token)
-//!       ∪ T(D[k−1] ∪ {0})           substitution
-//!       ∪ T(D'[k−1] ∪ {0})          deletion (pattern position skipped)
+//! D'[v] = T(D[v] ∪ Iᵥ) ∩ B  ∪  T(D[v−1] ∪ Iᵥ₋₁) ∩ H  ∪  T(D[v−2] ∪ Iᵥ₋₂)   match, near, other
+//!       ∪ D[v−2]                                                          insertion
+//!       ∪ T(D'[v−2])  ∪  D'[v−1]                                          deletion, monotone
 //! ```
-//! A match of distance k ends at this token when `D'[k]` meets the accepting set. Since match
+//! A match of cost v ends at this token when `D'[v]` meets the accepting set. Since match
 //! starts are not tracked in the masks (that would cost 32× the RAM), the start of a match is
 //! found when needed by running the reversed automaton backwards over the token history
-//! ([`earliest_start`]), which also picks the longest match at that distance.
-//! RAM: `MAX_ACTIONS × (MAX_EDITS + 1) × 8` = 1 KiB.
+//! ([`earliest_start`]), which also picks the longest match at that cost.
+//! RAM: `MAX_ACTIONS × (2·MAX_EDITS + 1) × 8` = 1.75 KiB.
 
+use crate::alignment::{masks, FULL};
 use crate::pattern::{Library, Pattern, MAX_ACTIONS, MAX_EDITS};
 use crate::token::Token;
 
-/// Levels per action.
-pub const LEVELS: usize = MAX_EDITS + 1;
+/// Cost levels per action: 0 ..= 2·[`MAX_EDITS`] half-edits.
+pub const LEVELS: usize = 2 * MAX_EDITS + 1;
+
+/// Highest cost level of pattern `p`, half-edits: its edit bound in whole edits.
+pub fn top_level(p: &Pattern<'_>) -> usize {
+    (usize::from(FULL) * p.max_edits()).min(LEVELS - 1)
+}
 
 /// The automata state of every action.
 #[derive(Debug, Clone)]
@@ -37,37 +45,39 @@ impl Default for MatcherBank {
     }
 }
 
-/// Matches ending at the latest token: best distance per action (`u8::MAX` = none).
+/// Matches ending at the latest token: lowest cost per action, half-edits (`u8::MAX` =
+/// none).
 pub type Matches = [u8; MAX_ACTIONS];
 
-/// One automaton step of pattern `p` over `levels` (only `0..=p.max_edits()` are used).
-/// Returns the smallest k whose level accepts, if any.
+/// One automaton step of pattern `p` over `d` (only `0..=top_level(p)` are used). Returns
+/// the lowest cost level that accepts, if any.
 fn step_pattern(p: &Pattern<'_>, d: &mut [u64; LEVELS], c: Token) -> Option<u8> {
-    let b = p.symbol_mask(c);
-    let k_max = p.max_edits().min(MAX_EDITS);
+    let (exact, near) = masks(p, c);
     let last = p.last();
     let mut best = None;
-    let mut prev_old = 0u64;
-    let mut prev_new = 0u64;
-    // Where a match may begin at level k: the start, or up to k leading pattern positions
-    // skipped (each skip one edit).
-    let mut init = 1u64;
-    for (k, slot) in d.iter_mut().enumerate().take(k_max + 1) {
-        if k > 0 {
-            init |= p.forward_outlined(init) & !1;
-        }
-        let old = *slot;
-        let mut new = p.forward(old | init) & b;
-        if k > 0 {
-            new |= prev_old | p.forward(prev_old | 1) | p.forward(prev_new | 1);
-        }
-        new &= !1;
+    // Rolling values of the levels below v: starts I, old levels with their starts and their
+    // forward images, new levels and the forward images of new levels.
+    let (mut i1, mut i2) = (0u64, 0u64);
+    let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
+    let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
+    for (v, slot) in d.iter_mut().enumerate().take(top_level(p) + 1) {
+        // Leading deletions: each one FULL.
+        let iv = if v == 0 {
+            1
+        } else {
+            i1 | (p.forward_outlined(i2) & !1)
+        };
+        let old = *slot | iv;
+        let f0 = p.forward(old);
+        let new = ((f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2) & !1;
         *slot = new;
         if best.is_none() && new & last != 0 {
-            best = Some(k as u8);
+            best = Some(v as u8);
         }
-        prev_old = old;
-        prev_new = new;
+        let g0 = p.forward(new);
+        (i2, i1) = (i1, iv);
+        (o2, o1, f2, f1) = (o1, old, f1, f0);
+        (n1, g2, g1) = (new, g1, g0);
     }
     best
 }
@@ -118,65 +128,60 @@ pub fn prefix_alive(p: &Pattern<'_>, tokens: &[Token], skip_first: bool) -> bool
 
 /// Runs pattern `p` backwards over the tokens ending a match: `token_back(0)` is the last
 /// token of the match, `token_back(j)` the one `j` tokens earlier (`None` past the available
-/// history). Returns `(j, k)`: the largest `j` such that tokens `j..=0` match `p` with
-/// `k ≤ max_dist` edits (the longest match at the best distance), or `None`.
+/// history). Returns `(j, v)`: the largest `j` such that tokens `j..=0` match `p` at the
+/// lowest cost `v ≤ max_cost` half-edits (the longest match at the best cost), or `None`.
+/// The mirror of the forward automaton, levels and costs alike.
 pub fn earliest_start(
     p: &Pattern<'_>,
-    max_dist: u8,
+    max_cost: u8,
     mut token_back: impl FnMut(usize) -> Option<Token>,
 ) -> Option<(usize, u8)> {
-    let k_max = usize::from(max_dist).min(p.max_edits()).min(MAX_EDITS);
+    // A virtual state after the accepting ones.
     const END: u64 = 1 << 63;
+    let mut top = usize::from(max_cost).min(top_level(p));
     let first = p.first();
     let rev = |d: u64| -> u64 {
         let mut r = p.backward(d & !END);
         if d & END != 0 {
             r |= p.last();
         }
-        r
+        r & !1
     };
-    // Before reading: the virtual end state, closed under trailing deletions.
+    // Before reading: the end, and the positions trailing deletions (each FULL) reach.
     let mut d = [0u64; LEVELS];
-    d[0] = END;
-    for k in 1..=k_max {
-        d[k] = d[k - 1] | rev(d[k - 1]);
+    let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
+    for (v, slot) in d.iter_mut().enumerate().take(top + 1) {
+        let n = if v == 0 { END } else { n1 } | g2;
+        *slot = n;
+        let g = rev(n);
+        (n1, g2, g1) = (n, g1, g);
     }
     let mut found: Option<(usize, u8)> = None;
     let mut j = 0;
     while let Some(c) = token_back(j) {
-        let b = p.symbol_mask(c);
-        let mut prev_old = 0u64;
-        let mut prev_new = 0u64;
+        let (exact, near) = masks(p, c);
+        let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
+        let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
         let mut live = false;
-        for (k, slot) in d.iter_mut().enumerate().take(k_max + 1) {
+        for (v, slot) in d.iter_mut().enumerate().take(top + 1) {
             let old = *slot;
-            let mut new = rev(old) & b;
-            if k > 0 {
-                new |= (prev_old & !END) | rev(prev_old) | rev(prev_new);
-            }
-            new &= !1 & !END;
+            let f0 = rev(old);
+            let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
             *slot = new;
             live |= new != 0;
-            // A match may start here, at a first position of the pattern, or after leading
-            // positions that were skipped (each skip one more edit, as the forward automaton
-            // allows).
-            let mut reach = new;
-            for kk in k..=k_max {
-                if reach & first != 0 {
-                    // Keep the lowest distance; among equal distances the longest (latest j).
-                    match found {
-                        Some((_, fk)) if fk < kk as u8 => {}
-                        _ => found = Some((j, kk as u8)),
-                    }
-                    break;
+            // A match may start here, at a first position of the pattern (leading deletions
+            // are in `new` already: the backward deletion term).
+            if new & first != 0 {
+                // The lowest cost wins; at equal cost the longest (latest j).
+                if found.is_none_or(|(_, fv)| v as u8 <= fv) {
+                    found = Some((j, v as u8));
                 }
-                reach = rev(reach) & !1 & !END;
-                if reach == 0 {
-                    break;
-                }
+                // Higher levels can only find costlier starts.
+                top = v;
             }
-            prev_old = old;
-            prev_new = new;
+            let g0 = rev(new);
+            (o2, o1, f2, f1) = (o1, old, f1, f0);
+            (n1, g2, g1) = (new, g1, g0);
         }
         if !live {
             break;
@@ -222,15 +227,23 @@ mod tests {
     }
 
     #[test]
-    fn edits_are_counted_and_bounded() {
+    fn edits_are_counted_in_half_edits_and_bounded() {
         let blob = seq_library(&[(&["u", "f", "d", "b"], 1)]);
-        // One substitution (r for d).
-        assert_eq!(run(&blob, "u f r b")[3][0], 1);
+        // One substitution (r for d): a whole edit.
+        assert_eq!(run(&blob, "u f r b")[3][0], 2);
+        // One near substitution (`df`, 45° from `d`; `d.Xp`, another rotation): half of one.
+        assert_eq!(run(&blob, "u f df b")[3][0], 1);
+        assert_eq!(run(&blob, "u f d.Xp b")[3][0], 1);
         // One insertion (l).
-        assert_eq!(run(&blob, "u f l d b")[4][0], 1);
+        assert_eq!(run(&blob, "u f l d b")[4][0], 2);
         // One deletion (f missing).
-        assert_eq!(run(&blob, "u d b")[2][0], 1);
-        // Two edits exceed the bound.
+        assert_eq!(run(&blob, "u d b")[2][0], 2);
+        // The bound (one edit) admits two near substitutions, not two whole edits.
+        assert_eq!(
+            top_level(&Library::from_bytes(&blob).unwrap().pattern(0).unwrap()),
+            2
+        );
+        assert_eq!(run(&blob, "uf f df b")[3][0], 2);
         assert_eq!(run(&blob, "u r r b")[3][0], 255);
     }
 
@@ -238,17 +251,17 @@ mod tests {
     fn the_first_parts_of_a_pattern_may_be_missing() {
         // A punch without its wind-up: `f b` is `b f b` with the leading `b` deleted.
         let blob = seq_library(&[(&["b", "f", "b"], 1), (&["u", "f", "d", "b"], 2)]);
-        assert_eq!(run(&blob, "f b")[1][0], 1);
-        // Two leading parts missing: two edits.
-        assert_eq!(run(&blob, "d b")[1][1], 2);
+        assert_eq!(run(&blob, "f b")[1][0], 2);
+        // Two leading parts missing: two edits, the bound of the second pattern.
+        assert_eq!(run(&blob, "d b")[1][1], 4);
         assert_eq!(run(&blob, "b")[0][1], 255);
         // The reverse search agrees on where such a match starts and what it costs.
         let lib = Library::from_bytes(&blob).unwrap();
         let p = lib.pattern(0).unwrap();
         let stream = toks("f b");
         let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 1, back), Some((1, 1)));
-        assert_eq!(earliest_start(&p, 0, back), None);
+        assert_eq!(earliest_start(&p, 2, back), Some((1, 2)));
+        assert_eq!(earliest_start(&p, 1, back), None);
     }
 
     #[test]
@@ -275,10 +288,52 @@ mod tests {
         assert_eq!(earliest_start(&p, 0, back), Some((2, 0)));
         // With one edit allowed, the extra leading `b` is not taken when it costs more.
         let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 1, back), Some((2, 0)));
+        assert_eq!(earliest_start(&p, 2, back), Some((2, 0)));
         let stream = toks("u f l d");
         let stream: Vec<Token> = stream;
         let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 1, back), Some((3, 1)));
+        assert_eq!(earliest_start(&p, 2, back), Some((3, 2)));
+        // A near token costs half an edit at the start too.
+        let stream = toks("uf f d");
+        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
+        assert_eq!(earliest_start(&p, 2, back), Some((2, 1)));
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn automaton_and_reverse_search_agree_with_the_alignment_cost(
+            pat in proptest::collection::vec(0usize..8, 2..6),
+            bound in 0u8..3,
+            text in proptest::collection::vec(0usize..8, 1..10),
+        ) {
+            use crate::alignment::weighted_cost;
+            const NAMES: [&str; 8] = ["u", "uf", "f", "d", "d.Xp", "f.Xn", ".Xp", "lu"];
+            let names: Vec<&str> = pat.iter().map(|&i| NAMES[i]).collect();
+            let bound = bound.min(names.len() as u8 - 1);
+            let blob = seq_library(&[(&names, bound)]);
+            let lib = Library::from_bytes(&blob).unwrap();
+            let p = lib.pattern(0).unwrap();
+            let t: Vec<Token> = text.iter().map(|&i| parse_token(NAMES[i]).unwrap()).collect();
+            let top = FULL * bound;
+            let mut bank = MatcherBank::new();
+            for end in 0..t.len() {
+                let mut m = [0u8; MAX_ACTIONS];
+                bank.step(&lib, t[end], &mut m);
+                // The cheapest match ending here, over every start, within the bound.
+                let costs: Vec<Option<u8>> = (0..=end)
+                    .map(|s| weighted_cost(&p, &t[s..=end], top))
+                    .collect();
+                let best = costs.iter().flatten().min().copied();
+                prop_assert_eq!(m[0], best.unwrap_or(u8::MAX), "end {}", end);
+                let back = |j: usize| end.checked_sub(j).map(|i| t[i]);
+                let found = earliest_start(&p, m[0].min(top), back);
+                let longest = best.and_then(|b| {
+                    (0..=end).find(|&s| costs[s] == Some(b)).map(|s| (end - s, b))
+                });
+                prop_assert_eq!(found, longest, "end {}", end);
+            }
+        }
     }
 }

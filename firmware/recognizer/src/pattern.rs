@@ -110,6 +110,18 @@ impl<'a> Pattern<'a> {
     pub fn first(&self) -> u64 {
         self.follow(0)
     }
+    /// The symbols of positions 1..=n, in order.
+    pub fn symbols(&self) -> impl Iterator<Item = Symbol> + 'a {
+        let n = self.positions();
+        self.rec
+            .get(36..36 + 2 * n)
+            .unwrap_or(&[])
+            .chunks_exact(2)
+            .map(|b| match b {
+                [lo, hi] => u16::from_le_bytes([*lo, *hi]),
+                _ => STILL,
+            })
+    }
     /// Positions whose symbol is `t`.
     pub fn symbol_mask(&self, t: Token) -> u64 {
         let mut m = 0u64;
@@ -144,9 +156,16 @@ impl<'a> Pattern<'a> {
     }
     /// Backward transition: all states with a successor in `d`.
     pub fn backward(&self, d: u64) -> u64 {
+        let n = self.positions();
+        let at = 36 + 2 * n;
+        let follows = self.rec.get(at..at + 8 * (n + 1)).unwrap_or(&[]);
         let mut out = 0u64;
-        for i in 0..=self.positions() {
-            if self.follow(i) & d != 0 {
+        for (i, f) in follows.chunks_exact(8).enumerate() {
+            let f = match f {
+                [a, b, c, e, g, h, k, l] => u64::from_le_bytes([*a, *b, *c, *e, *g, *h, *k, *l]),
+                _ => 0,
+            };
+            if f & d != 0 {
                 out |= 1 << i;
             }
         }

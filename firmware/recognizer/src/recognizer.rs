@@ -7,7 +7,7 @@
 //! provisional report 0.5 KiB — 13.3 KiB in all (13,648 B by `size_of`, measured by a test)
 //! with 32 actions loaded.
 
-use crate::alignment::{weighted_cost, FULL};
+use crate::alignment::FULL;
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
@@ -415,28 +415,19 @@ impl<'lib> Recognizer<'lib> {
             let Some(p) = self.library.pattern(a) else {
                 continue;
             };
-            let found = earliest_start(&p, d, back);
-            let Some((j, k)) = found else { continue };
-            if !edits_fit(k, (j + 1).max(p.min_len())) {
+            // Lowest cost first, then the longest match at that cost; held to the share of
+            // edits per token (in half-edits) as well as to the action's bound.
+            let Some((j, cost)) = earliest_start(&p, d, back) else {
                 continue;
-            }
-            // Each edit costs at least HALF: skip what cannot beat the best so far.
-            let len = (j + 1) as i32;
-            if best.is_some_and(|b| 4 * len - 3 * i32::from(k) < b.merit()) {
-                continue;
-            }
-            // The match is the last j + 1 tokens; an exact one costs nothing.
-            let cost = if k == 0 {
-                0
-            } else {
-                let span = tok.get(HISTORY_RUNS.wrapping_sub(1 + j)..).unwrap_or(&[]);
-                weighted_cost(&p, span, FULL * k).unwrap_or(FULL * k)
             };
+            if !edits_fit(cost, (j + 1).max(p.min_len())) {
+                continue;
+            }
             let c = Candidate {
                 action: a as u8,
                 start: idx.get(j).copied().unwrap_or(end),
                 end,
-                distance: k,
+                distance: cost.div_ceil(FULL),
                 cost,
                 len: (j + 1) as u16,
                 min_len: p.min_len().min(255) as u8,

@@ -47,9 +47,10 @@ pub const INEXACT_HOLD_US: u64 = 1_000_000;
 /// turning a lone stroke into any action.
 pub const EDIT_SHARE: (usize, usize) = (2, 5);
 
-/// Whether a match of `len` tokens with `edits` edits is close enough ([`EDIT_SHARE`]).
-pub const fn edits_fit(edits: u8, len: usize) -> bool {
-    (edits as usize) * EDIT_SHARE.1 <= EDIT_SHARE.0 * len
+/// Whether a match over `len` tokens (or the pattern's shortest match, if longer) that costs
+/// `cost` half-edits ([`crate::alignment`]) is close enough ([`EDIT_SHARE`]).
+pub const fn edits_fit(cost: u8, len: usize) -> bool {
+    (cost as usize) * EDIT_SHARE.1 <= EDIT_SHARE.0 * 2 * len
 }
 
 /// Shortest action that is emitted, µs (first run's start to last run's end).
@@ -253,12 +254,14 @@ mod tests {
 
     #[test]
     fn edits_are_bounded_by_the_share_of_the_match() {
+        // In half-edits: one whole edit needs 3 tokens, half of one 2.
         assert!(edits_fit(0, 1));
-        assert!(!edits_fit(1, 2));
-        assert!(edits_fit(1, 3));
-        assert!(!edits_fit(2, 4));
-        assert!(edits_fit(2, 5));
-        assert!(edits_fit(3, 8));
+        assert!(!edits_fit(2, 2));
+        assert!(edits_fit(1, 2));
+        assert!(edits_fit(2, 3));
+        assert!(!edits_fit(4, 4));
+        assert!(edits_fit(4, 5));
+        assert!(edits_fit(6, 8));
     }
 
     #[test]

@@ -24,6 +24,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::segment::edits_fit;
@@ -409,7 +410,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
                 }
                 Op::Del(i) => {
                     missing[i] += 1;
-                    lacked_by_short[i] |= !edits_fit(1, s.len());
+                    lacked_by_short[i] |= !edits_fit(FULL, s.len());
                 }
                 Op::Ins(_) => {}
             }
@@ -590,7 +591,8 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     }
 }
 
-/// Distance of the best match of `entry`'s pattern covering all of `tokens`, if within its bound.
+/// Cost in half-edits (a near substitution costs one, other edits two) of the best match of
+/// `entry`'s pattern covering all of `tokens`, if within its bound.
 pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
     let mut one = LibraryFile::default();
     one.actions.push(entry.clone());
@@ -608,8 +610,8 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
         return Ok(None);
     }
     let back = |j: usize| tokens.len().checked_sub(j + 1).map(|i| tokens[i]);
-    for d in m[0]..=entry.max_edits {
-        if let Some((j, k)) = earliest_start(&p, d, back) {
+    for cost in m[0]..=FULL * entry.max_edits {
+        if let Some((j, k)) = earliest_start(&p, cost, back) {
             if j + 1 == tokens.len() {
                 return Ok(Some(k));
             }
@@ -710,8 +712,11 @@ pub fn collisions(lib: &LibraryFile, entry: &ActionEntry) -> Result<Vec<String>>
             if let Some(d) = full_match(other, &t)? {
                 out.push(format!(
                     "an example of `{}` ({ex}) is also matched by existing action `{}` \
-                     (pattern `{}`, distance {d})",
-                    entry.name, other.name, other.regex
+                     (pattern `{}`, {} edits)",
+                    entry.name,
+                    other.name,
+                    other.regex,
+                    f32::from(d) / 2.0
                 ));
                 break;
             }
@@ -721,8 +726,10 @@ pub fn collisions(lib: &LibraryFile, entry: &ActionEntry) -> Result<Vec<String>>
             if let Some(d) = full_match(entry, &t)? {
                 out.push(format!(
                     "the new pattern of `{}` also matches an example of existing action `{}` \
-                     ({ex}, distance {d})",
-                    entry.name, other.name
+                     ({ex}, {} edits)",
+                    entry.name,
+                    other.name,
+                    f32::from(d) / 2.0
                 ));
                 break;
             }
@@ -752,7 +759,7 @@ pub fn run(args: &LearnArgs) -> Result<()> {
             "  {}: {ex}  [{}]",
             p.display(),
             match ok {
-                Some(d) => format!("matched, distance {d}"),
+                Some(d) => format!("matched, {} edits", f32::from(d) / 2.0),
                 None => "NOT matched".into(),
             }
         );
