@@ -564,8 +564,9 @@ fn simplify(alt: Regex) -> Regex {
 }
 
 /// Learns a pattern that also accepts the mirror images (left ↔ right) of the examples: a
-/// figurine action done to the other side is the same action. Falls back to the examples'
-/// own pattern when both do not fit the device together.
+/// figurine action done to the other side is the same action. When both sides do not fit the
+/// device together, optional groups are shed evenly, then rotation variants become wildcards
+/// ([`compact_rotations`]); only when even that does not fit is it the examples' own side.
 pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     let direct = learn_regex(seqs)?;
     let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
@@ -577,17 +578,52 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     }
     // Both sides within the device's positions: shed optional groups evenly if needed.
     let half = MAX_POSITIONS / 2;
-    let (Ok(d), Ok(m)) = (
+    let both = Regex::Alt(vec![direct.clone(), mirror.clone()]);
+    if both.positions() <= MAX_POSITIONS {
+        return Ok(both);
+    }
+    if let (Ok(d), Ok(m)) = (
         learn_regex_within(seqs, half),
         learn_regex_within(&mirrored, half),
-    ) else {
-        return Ok(direct);
-    };
-    let both = Regex::Alt(vec![direct.clone(), mirror]);
+    ) {
+        return Ok(Regex::Alt(vec![d, m]));
+    }
+    // Still too big: a stroke's rotation variants (`lu.Zn|lu|lu.Zp`) become one wildcard
+    // (`lu~`) — a rotation that differs costs only half an edit on the device anyway — so
+    // that both sides fit; one side alone would never recognise the other.
+    let (d, m) = (compact_rotations(&direct), compact_rotations(&mirror));
+    let both = Regex::Alt(vec![d, m]);
     if both.positions() <= MAX_POSITIONS {
         Ok(both)
     } else {
-        Ok(Regex::Alt(vec![d, m]))
+        Ok(direct)
+    }
+}
+
+/// `re` with every alternation of plain tokens that share one translation (`f.Zn|f|f.Zp`)
+/// written as that translation with any rotation (`f~`).
+pub fn compact_rotations(re: &Regex) -> Regex {
+    let lin = |r: &Regex| match r {
+        Regex::Sym(s) if s & (ANY_LIN | ANY_ROT) == 0 && s / 27 != NONE_BIN => Some(s / 27),
+        Regex::Sym(s) if s & ANY_ROT != 0 => Some((s & 0x3ff) / 27),
+        _ => None,
+    };
+    match re {
+        Regex::Alt(v) if v.len() > 1 => {
+            let first = lin(&v[0]);
+            if first.is_some() && v.iter().all(|r| lin(r) == first) {
+                let l = first.unwrap_or(NONE_BIN);
+                Regex::Sym((l * 27 + NONE_BIN) | ANY_ROT)
+            } else {
+                Regex::Alt(v.iter().map(compact_rotations).collect())
+            }
+        }
+        Regex::Alt(v) => Regex::Alt(v.iter().map(compact_rotations).collect()),
+        Regex::Cat(v) => Regex::Cat(v.iter().map(compact_rotations).collect()),
+        Regex::Star(r) => Regex::Star(Box::new(compact_rotations(r))),
+        Regex::Plus(r) => Regex::Plus(Box::new(compact_rotations(r))),
+        Regex::Opt(r) => Regex::Opt(Box::new(compact_rotations(r))),
+        Regex::Sym(s) => Regex::Sym(*s),
     }
 }
 
@@ -1011,6 +1047,28 @@ mod tests {
         assert!(c.accepts(&tokens_only(&seq("l:1 .Yp:1"))));
         assert!(c.accepts(&tokens_only(&seq("r:1 .Yn:1"))));
         assert!(!c.accepts(&tokens_only(&seq("r:1 .Yp:1"))));
+    }
+
+    #[test]
+    fn a_mirrored_pattern_too_big_for_both_sides_writes_rotations_as_wildcards() {
+        let re = Regex::parse("(f.Zn|f|f.Zp)+ (b|d)* lu.Zn").unwrap();
+        assert_eq!(compact_rotations(&re).to_source(), "f~+ (b|d)* lu.Zn");
+        // Nine strokes, each seen rolling both ways: 18 positions a side, too many for two.
+        let a = "lu.Zn:0.2 ld.Zp:0.2 u.Zn:0.2 d.Zp:0.2 lb.Zn:0.2 lf.Zp:0.2 ub.Zn:0.2 \
+                 df.Zp:0.2 l.Zn:0.2";
+        let b = "lu.Zp:0.2 ld.Zn:0.2 u.Zp:0.2 d.Zn:0.2 lb.Zp:0.2 lf.Zn:0.2 ub.Zp:0.2 \
+                 df.Zn:0.2 l.Zp:0.2";
+        let seqs = vec![seq(a), seq(b), seq(a)];
+        assert!(learn_regex(&seqs).unwrap().positions() > MAX_POSITIONS / 2);
+        let re = learn_regex_mirrored(&seqs).unwrap();
+        assert!(re.to_source().contains("lu~"), "{}", re.to_source());
+        let c = re.compile().unwrap();
+        assert!(c.accepts(&tokens_only(&seqs[0])), "{}", re.to_source());
+        assert!(
+            c.accepts(&tokens_only(&mirror_seq(&seqs[0]))),
+            "{}",
+            re.to_source()
+        );
     }
 
     #[test]
