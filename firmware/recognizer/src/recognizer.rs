@@ -18,7 +18,7 @@ use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, HOLD_BACK_TOKENS,
-    INEXACT_HOLD_US, LONG_PAUSE_US, LOOKAHEAD_TOKENS, MIN_ACTION_US, PAUSE_US,
+    INEXACT_HOLD_US, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -251,9 +251,11 @@ impl<'lib> Recognizer<'lib> {
                 }
             }
         }
-        // Nor once the figurine has clearly moved on.
+        // Nor once its runs are leaving the history. (A next cycle of many runs — a walk's
+        // two hops — is still under way well past a few runs; what moved in between is
+        // checked by `continues`.)
         if let (Some(h), Some(n)) = (self.held, newest) {
-            if n.wrapping_sub(h.end_run) > 2 * u32::from(LOOKAHEAD_TOKENS) {
+            if n.wrapping_sub(h.end_run) >= HISTORY_RUNS as u32 {
                 self.held = None;
             }
         }
@@ -749,6 +751,34 @@ mod tests {
             ev[0].decided_us - ev[0].end_us < crate::segment::CYCLIC_PAUSE_US,
             "{ev:?}"
         );
+    }
+
+    #[test]
+    fn a_next_cycle_of_many_runs_still_continues_the_event() {
+        // A cycle of two hops (`(uf f df uf f df)+`): the next cycle is some nine runs after
+        // the last one's end by the time it is matched.
+        let syms: Vec<Token> = ["uf", "f", "df", "uf", "f", "df"]
+            .iter()
+            .map(|t| crate::token::parse_token(t).unwrap())
+            .collect();
+        // Each position may repeat (`uf+ f+ df+ …`), as in `hop_library`.
+        let mut follow: Vec<u64> = (0..=6u32).map(|i| (1 << i) | (1 << (i + 1))).collect();
+        follow[0] = 1 << 1;
+        follow[6] = (1 << 6) | (1 << 1);
+        let mut blob = Vec::from(*b"FGL\x01");
+        blob.extend([1, 0, 0, 0]);
+        // One edit: each hop begins with a brief `u`, extra inside the cycle.
+        crate::pattern::encode_record(&mut blob, &syms, &follow, 1 << 6, 1, true).unwrap();
+        let lib = Library::from_bytes(&blob).unwrap();
+        // 450 ms between hops: a cycle is committed (`CYCLIC_PAUSE_US`) before the next one
+        // begins, and the action goes on (`CONTINUE_US`).
+        let ev = run(&lib, &paused_hops(4, 0.45));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, true],
+            "{ev:?}"
+        );
+        assert_eq!(ev[1].start_us, ev[0].start_us);
     }
 
     #[test]
