@@ -31,7 +31,8 @@ pub struct ActionRecord {
     pub time: f64,
     /// Laban Weight effort Lw in [-1, 1]: > 0 strong, < 0 light.
     pub weight: f64,
-    /// Edit distance of the approximate match (0 = exact).
+    /// Edit distance of the approximate match, whole edits (0 = exact; a near substitution —
+    /// the same stroke with another rotation, or one 45° off — counts half; rounded up).
     pub distance: u32,
 }
 

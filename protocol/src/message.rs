@@ -79,7 +79,8 @@ pub struct ActionEvent {
     pub time: i8,
     /// Laban Weight effort Lw × 127 (> 0 strong, < 0 light).
     pub weight: i8,
-    /// Edit distance of the approximate match.
+    /// Edit distance of the approximate match, whole edits (near substitutions count half;
+    /// rounded up).
     pub distance: u8,
 }
 

@@ -21,7 +21,7 @@
 //! |---|---|---|
 //! | [`pattern::MAX_ACTIONS`] | 32 actions | 64 B of record offsets (patterns stay in flash) |
 //! | [`pattern::MAX_POSITIONS`] | 32 tokens per pattern | blob ≤ [`pattern::MAX_LIBRARY_BYTES`] (flash) |
-//! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 4 × 8 B = 1 KiB of automaton state |
+//! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 7 × 8 B = 1.75 KiB of automaton state (half-edit levels) |
 //! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.7 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |

@@ -2,10 +2,10 @@
 //!
 //! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
-//! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1 KiB,
-//! effort model 0.6 KiB, the last cyclic event (open to continuation) and the state before a
-//! provisional report 0.5 KiB — 13.3 KiB in all (13,648 B by `size_of`, measured by a test)
-//! with 32 actions loaded.
+//! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
+//! effort model 0.6 KiB, the last cyclic event (open to continuation), the state before a
+//! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
+//! all (14,440 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::FULL;
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
@@ -45,7 +45,7 @@ pub struct ActionEvent {
     pub time_q: i8,
     /// Laban Weight Lw quantised: value = q / 127, > 0 strong.
     pub weight_q: i8,
-    /// Edit distance of the match.
+    /// Edit distance of the match, whole edits (a near substitution counts half; rounded up).
     pub distance: u8,
     /// Sequence number of the sample at which the decision was taken.
     pub decided_seq: u32,
