@@ -140,17 +140,11 @@ pub fn weighted_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8>
 mod tests {
     extern crate std;
     use super::*;
-    use crate::pattern::tests::seq_library;
+    use crate::pattern::tests::{seq_library, toks};
     use crate::pattern::Library;
     use crate::token::{parse_token, token_signs, Symbol};
     use proptest::prelude::*;
     use std::vec::Vec;
-
-    fn toks(s: &str) -> Vec<Token> {
-        s.split_whitespace()
-            .map(|t| parse_token(t).unwrap())
-            .collect()
-    }
 
     /// Cost of `tokens` against the pattern `pattern[0]+ pattern[1]+ …`.
     fn cost(pattern: &[&str], tokens: &str) -> Option<u8> {

@@ -195,15 +195,9 @@ pub fn earliest_start(
 mod tests {
     extern crate std;
     use super::*;
-    use crate::pattern::tests::seq_library;
+    use crate::pattern::tests::{seq_library, toks};
     use crate::token::parse_token;
     use std::vec::Vec;
-
-    fn toks(s: &str) -> Vec<Token> {
-        s.split_whitespace()
-            .map(|t| parse_token(t).unwrap())
-            .collect()
-    }
 
     fn run(blob: &[u8], stream: &str) -> Vec<Matches> {
         let lib = Library::from_bytes(blob).unwrap();

@@ -374,6 +374,13 @@ pub(crate) mod tests {
     use crate::token::parse_token;
     use std::vec::Vec;
 
+    /// Tokens from their names (`"u f d.Xp"`), for tests.
+    pub fn toks(s: &str) -> Vec<Token> {
+        s.split_whitespace()
+            .map(|t| parse_token(t).unwrap())
+            .collect()
+    }
+
     /// A library of sequential patterns `t1+ t2+ …` (each token repeatable), for tests.
     pub fn seq_library(actions: &[(&[&str], u8)]) -> Vec<u8> {
         let mut out = Vec::from(*b"FGL\x01");
