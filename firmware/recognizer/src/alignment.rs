@@ -1,14 +1,14 @@
-//! Stage 6a — how well a candidate match fits its pattern, for ranking candidates.
+//! Stage 5a — weighted edit costs: how far a token is from what a pattern position expects.
 //!
-//! The automata of [`crate::automaton`] count every edit as one, which is what a bound needs.
-//! Ranking two candidates that both fit their bound needs a finer measure: a token that
-//! disagrees with the pattern only about its rotation (`u.Xn` where the examples showed `u` —
-//! the toy wobbled while it rose) is a far smaller departure than a stroke that is missing or
-//! extra, because rotation modifiers come and go with how the toy is held, while strokes are
-//! the gesture. So a crouch `d.Xp u.Xn` (one rotation disagreement) ranks above a jump that
-//! explains the same tokens by leaving out its landing.
+//! A token that disagrees with the pattern only about its rotation (`u.Xn` where the examples
+//! showed `u` — the toy wobbled while it rose), or whose stroke is 45° off, is a far smaller
+//! departure than a stroke that is missing or extra: rotation modifiers come and go with how
+//! the toy is held, while strokes are the gesture. So such near substitutions cost half an
+//! edit, in the automata ([`crate::automaton`]) and in whole-phrase comparisons
+//! ([`crate::nearest`]) alike; a crouch `d.Xp u.Xn u` (one rotation disagreement) then ranks
+//! above a jump that explains the same tokens by leaving out its landing.
 //!
-//! [`weighted_cost`] is the edit distance between a candidate's tokens and its whole pattern
+//! [`weighted_cost`] is the edit distance between a token string and a whole pattern
 //! with these costs, in half-edits: insertion, deletion and substitution [`FULL`]; a
 //! substitution [`HALF`] between two moving tokens that differ only in their rotation half, or
 //! only in one component of their translation direction at the same rotation (`uf` for `f`:
@@ -19,8 +19,10 @@
 //! D'[v] = T(D[v]) ∩ B  ∪  T(D[v−1]) ∩ H  ∪  T(D[v−2])   match, half and full substitution
 //!       ∪ D[v−2]  ∪  D'[v−1]  ∪  T(D'[v−2])               insertion, monotone, deletion
 //! ```
-//! Levels go up to the bound the caller asks for (at most [`MAX_COST`]), so its cost is
-//! `tokens × levels` forward steps — run once per inexact candidate, never per sample.
+//! The automata read each token with the same update (`advance`), adding at every token the
+//! start a match may take there. [`weighted_cost`] is for whole phrases
+//! ([`crate::nearest`]): its levels go up to the bound the caller asks for (at most
+//! [`MAX_COST`]), so it costs `tokens × levels` forward steps, once per pause.
 
 use crate::pattern::{Pattern, MAX_POSITIONS};
 use crate::token::{symbol_matches, Token, ANY_LIN, ANY_ROT, NONE_BIN, STILL};
@@ -92,48 +94,69 @@ pub(crate) fn masks(p: &Pattern<'_>, c: Token) -> (u64, u64) {
     (exact, half)
 }
 
+/// Reads token `c` into the cost levels `d` (level v: the states reached at cost ≤ v
+/// half-edits) — the recurrence of the module docs. With `anywhere`, a match may also begin
+/// at `c` (the automata of [`crate::automaton`]: matches start anywhere in the stream);
+/// without, every alignment began at the first token. Returns the lowest level that accepts.
+#[inline]
+pub(crate) fn advance(p: &Pattern<'_>, d: &mut [u64], c: Token, anywhere: bool) -> Option<u8> {
+    let (exact, near) = masks(p, c);
+    let last = p.last();
+    let mut best = None;
+    // Rolling values of the levels below v: starts I, old levels with their starts and their
+    // forward images, new levels and the forward images of new levels.
+    let (mut i1, mut i2) = (0u64, 0u64);
+    let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
+    let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
+    for (v, slot) in d.iter_mut().enumerate() {
+        // The start, and leading deletions (each FULL).
+        let iv = match (anywhere, v) {
+            (false, _) => 0,
+            (true, 0) => 1,
+            (true, _) => i1 | (p.forward_outlined(i2) & !1),
+        };
+        let old = *slot | iv;
+        let f0 = p.forward(old);
+        let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
+        *slot = new;
+        if best.is_none() && new & last != 0 {
+            best = Some(v as u8);
+        }
+        let g0 = p.forward(new);
+        (i2, i1) = (i1, iv);
+        (o2, o1, f2, f1) = (o1, old, f1, f0);
+        (n1, g2, g1) = (new, g1, g0);
+    }
+    best
+}
+
 /// Weighted edit distance (half-edits) between `tokens` (oldest first) and the whole of
 /// pattern `p`: the cheapest way to read all the tokens from the initial state to an
 /// accepting one. None when it exceeds `bound` (itself capped at [`MAX_COST`]).
-// Once per inexact candidate: out of line, one copy (flash).
+// Once per stand-alone phrase and action: out of line, one copy (flash).
 #[inline(never)]
 pub fn weighted_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8> {
-    let levels = usize::from(bound.min(MAX_COST)) + 1;
-    // Level v is updated in place, walking up; the levels below it (old and new) and their
-    // forward images ride along in these.
-    let mut d = [0u64; LEVELS];
+    let mut all = [0u64; LEVELS];
+    let d = all
+        .get_mut(..=usize::from(bound.min(MAX_COST)))
+        .unwrap_or(&mut []);
     // Before reading: the initial state, and the positions leading deletions reach.
     let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
-    for (v, slot) in d.iter_mut().take(levels).enumerate() {
+    for (v, slot) in d.iter_mut().enumerate() {
         let n = if v == 0 { 1 } else { n1 } | g2;
         *slot = n;
         let g = p.forward(n);
         (n1, g2, g1) = (n, g1, g);
     }
+    let mut best = d.iter().position(|&x| x & p.last() != 0).map(|v| v as u8);
     for &c in tokens {
-        let (exact, half) = masks(p, c);
-        // Old levels v−1, v−2 and forward images; new level v−1 and forward images v−1, v−2.
-        let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
-        let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
-        for slot in d.iter_mut().take(levels) {
-            let o0 = *slot;
-            let f0 = p.forward(o0);
-            let n = (f0 & exact) | (f1 & half) | f2 | o2 | n1 | g2;
-            *slot = n;
-            let g = p.forward(n);
-            (o2, o1, f2, f1) = (o1, o0, f1, f0);
-            (n1, g2, g1) = (n, g1, g);
-        }
-        if n1 == 0 {
+        best = advance(p, d, c, false);
+        if d.last().is_none_or(|&top| top == 0) {
             // Not even the top level reaches anything: over the bound.
             return None;
         }
     }
-    let last = p.last();
-    d.iter()
-        .take(levels)
-        .position(|&x| x & last != 0)
-        .map(|v| v as u8)
+    best
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@
 //! ([`earliest_start`]), which also picks the longest match at that cost.
 //! RAM: `MAX_ACTIONS × (2·MAX_EDITS + 1) × 8` = 1.75 KiB.
 
-use crate::alignment::{masks, FULL};
+use crate::alignment::{advance, masks, FULL};
 use crate::pattern::{Library, Pattern, MAX_ACTIONS, MAX_EDITS};
 use crate::token::Token;
 
@@ -52,34 +52,8 @@ pub type Matches = [u8; MAX_ACTIONS];
 /// One automaton step of pattern `p` over `d` (only `0..=top_level(p)` are used). Returns
 /// the lowest cost level that accepts, if any.
 fn step_pattern(p: &Pattern<'_>, d: &mut [u64; LEVELS], c: Token) -> Option<u8> {
-    let (exact, near) = masks(p, c);
-    let last = p.last();
-    let mut best = None;
-    // Rolling values of the levels below v: starts I, old levels with their starts and their
-    // forward images, new levels and the forward images of new levels.
-    let (mut i1, mut i2) = (0u64, 0u64);
-    let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
-    let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
-    for (v, slot) in d.iter_mut().enumerate().take(top_level(p) + 1) {
-        // Leading deletions: each one FULL.
-        let iv = if v == 0 {
-            1
-        } else {
-            i1 | (p.forward_outlined(i2) & !1)
-        };
-        let old = *slot | iv;
-        let f0 = p.forward(old);
-        let new = ((f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2) & !1;
-        *slot = new;
-        if best.is_none() && new & last != 0 {
-            best = Some(v as u8);
-        }
-        let g0 = p.forward(new);
-        (i2, i1) = (i1, iv);
-        (o2, o1, f2, f1) = (o1, old, f1, f0);
-        (n1, g2, g1) = (new, g1, g0);
-    }
-    best
+    let levels = d.get_mut(..=top_level(p)).unwrap_or(&mut []);
+    advance(p, levels, c, true)
 }
 
 impl MatcherBank {

@@ -9,9 +9,9 @@
 //! Stages, one module each, in data-flow order:
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
-//! [`automaton`] (bit-parallel Levenshtein automata) → [`segment`] (online decision;
-//! candidates ranked by [`alignment`]'s weighted edit distance, stand-alone gestures no
-//! action matched given to their [`nearest`] action) →
+//! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
+//! tokens cost half) → [`segment`] (online decision; stand-alone gestures no action matched
+//! given to their [`nearest`] action) →
 //! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.

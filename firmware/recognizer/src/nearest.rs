@@ -86,7 +86,8 @@ pub struct Nearest {
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
 /// phrase, when one is near enough ([`EDIT_SHARE`]); its `distance` is the weighted cost
 /// rounded up to whole edits. Ties of cost per aligned token go to the lower action index.
-/// None when there is no whole phrase (see [`phrase`]).
+/// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
+/// longer than [`NEAREST_MAX_TOKENS`].
 // Once per pause at most: kept out of the per-sample path (flash, not speed).
 #[cold]
 #[inline(never)]
