@@ -79,7 +79,8 @@ pub struct Nearest {
     /// The nearest action over the phrase, when near enough.
     pub candidate: Option<Candidate>,
     /// Some action's pattern has the phrase as the start of a match that is not over: the
-    /// pause may be a hold inside it, so the phrase stands alone only after [`HOLD_US`].
+    /// pause may be a hold inside that gesture, so the phrase does not stand alone (the
+    /// recognizer reports nothing for it; the automata take it up if the gesture goes on).
     pub open: bool,
 }
 
