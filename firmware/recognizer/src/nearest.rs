@@ -85,8 +85,7 @@ pub struct Nearest {
 }
 
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
-/// phrase, when one is near enough ([`EDIT_SHARE`]); its `distance` is the weighted cost
-/// rounded up to whole edits. Ties of cost per aligned token go to the lower action index.
+/// phrase, when one is near enough ([`EDIT_SHARE`]). Ties of cost per aligned token go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
 /// longer than [`NEAREST_MAX_TOKENS`].
 // Once per pause at most: kept out of the per-sample path (flash, not speed).
@@ -112,7 +111,6 @@ pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) 
             action: a as u8,
             start: first,
             end: last,
-            distance: cost.div_ceil(FULL),
             cost,
             len: n as u16,
             min_len: p.min_len().min(255) as u8,
@@ -177,7 +175,7 @@ mod tests {
         let n = nearest_action(&lib, &h, 0, 2).unwrap();
         let c = n.candidate.unwrap();
         assert_eq!(
-            (c.action, c.start, c.end, c.distance, c.cost),
+            (c.action, c.start, c.end, c.distance(), c.cost),
             (0, 1, 2, 1, FULL)
         );
         assert!(!n.open);
@@ -190,7 +188,7 @@ mod tests {
             ("_", 150),
         ]);
         let c = nearest_action(&lib, &h, 0, 3).unwrap().candidate.unwrap();
-        assert_eq!((c.action, c.cost, c.distance), (2, HALF, 1));
+        assert_eq!((c.action, c.cost, c.distance()), (2, HALF, 1));
         // Without its drop back as well, it is too far: 1.5 edits in 3 aligned tokens.
         let h = history(&[("_", 800), ("f.Xn", 200), ("b.Xp", 200), ("_", 150)]);
         assert_eq!(nearest_action(&lib, &h, 0, 2).unwrap().candidate, None);

@@ -7,7 +7,6 @@
 //! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
 //! all (14,440 B by `size_of`, measured by a test) with 32 actions loaded.
 
-use crate::alignment::FULL;
 use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
@@ -429,7 +428,6 @@ impl<'lib> Recognizer<'lib> {
                 action: a as u8,
                 start: idx.get(j).copied().unwrap_or(end),
                 end,
-                distance: cost.div_ceil(FULL),
                 cost,
                 len: (j + 1) as u16,
                 min_len: p.min_len().min(255) as u8,
@@ -468,7 +466,7 @@ impl<'lib> Recognizer<'lib> {
             Some(mut h) => {
                 h.end = ev.end;
                 h.end_run = c.end;
-                h.distance = h.distance.max(c.distance);
+                h.distance = h.distance.max(c.distance());
                 h.acc.merge(&ev.acc);
                 Some((h, true, Some(h)))
             }
@@ -538,7 +536,7 @@ impl<'lib> Recognizer<'lib> {
             start,
             end,
             end_run: c.end,
-            distance: c.distance,
+            distance: c.distance(),
             acc,
         })
     }

@@ -1,9 +1,9 @@
 //! Stage 6 — online segment decision: when to commit which action.
 //!
 //! Each token that completes one or more approximate matches yields candidates (action, first
-//! and last run, distance, length in tokens). A pending candidate is replaced by an overlapping
+//! and last run, weighted cost, length in tokens). A pending candidate is replaced by an overlapping
 //! one of higher merit `4·length − 3·cost`, the cost in half-edits
-//! ([`crate::alignment::weighted_cost`]: a token that differs from the pattern only in its
+//! ([`crate::alignment`]: a token that differs from the pattern only in its
 //! rotation, or by 45° in its direction, costs half an edit) — near-ties go to the longest
 //! action, as in seed 000 §7.5, and an action that keeps extending (a walk of several hops)
 //! grows instead of being cut. The pending candidate is committed when
@@ -69,10 +69,8 @@ pub struct Candidate {
     pub start: u32,
     /// Last run (absolute history index).
     pub end: u32,
-    /// Edit distance (each edit 1; what the action's bound limits).
-    pub distance: u8,
-    /// Weighted edit distance in half-edits ([`crate::alignment::weighted_cost`]): a
-    /// rotation-only disagreement costs half an edit. What candidates are ranked by.
+    /// Weighted edit distance in half-edits ([`crate::alignment`]: a near token costs half an
+    /// edit). What candidates are ranked by and held to their bound with.
     pub cost: u8,
     /// Non-STILL tokens covered.
     pub len: u16,
@@ -85,6 +83,11 @@ pub struct Candidate {
 }
 
 impl Candidate {
+    /// Edit distance in whole edits, rounded up: what an event reports.
+    pub fn distance(&self) -> u8 {
+        self.cost.div_ceil(crate::alignment::FULL)
+    }
+
     /// Ranking score, in quarter tokens: longer is better, each edit costs 1.5 tokens
     /// (a rotation-only disagreement half of that).
     pub fn merit(&self) -> i32 {
@@ -100,13 +103,13 @@ impl Candidate {
             self.merit(),
             self.min_len,
             other.positions,
-            other.distance,
+            other.cost,
             other.action,
         ) > (
             other.merit(),
             other.min_len,
             self.positions,
-            self.distance,
+            self.cost,
             self.action,
         )
     }
@@ -185,11 +188,7 @@ impl Decider {
             return Decision::Wait;
         };
         let pause = if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US };
-        let hold = if p.distance > 0 {
-            INEXACT_HOLD_US
-        } else {
-            HOLD_US
-        };
+        let hold = if p.cost > 0 { INEXACT_HOLD_US } else { HOLD_US };
         if still_us >= pause && (still_us >= hold || !longer_in_progress) {
             Decision::Commit(p)
         } else {
@@ -207,7 +206,6 @@ mod tests {
             action,
             start,
             end,
-            distance,
             cost: 2 * distance,
             len: (end - start + 1) as u16,
             min_len: 1,
