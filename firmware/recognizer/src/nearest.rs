@@ -76,7 +76,7 @@ fn phrase(
 /// What [`nearest_action`] found for one pause.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Nearest {
-    /// The nearest action over the phrase, when near enough.
+    /// The nearest action over the phrase, when near enough (never sought for an open one).
     pub candidate: Option<Candidate>,
     /// Some action's pattern has the phrase as the start of a match that is not over: the
     /// pause may be a hold inside that gesture, so the phrase does not stand alone (the
@@ -95,11 +95,19 @@ pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) 
     let mut tok = [STILL; NEAREST_MAX_TOKENS];
     let (n, first, last) = phrase(hist, floor, last, &mut tok)?;
     let tokens = tok.get(..n).unwrap_or(&[]);
+    // A phrase some action could still go on from is no gesture of its own: nothing to weigh.
+    if (0..lib.len())
+        .filter_map(|a| lib.pattern(a))
+        .any(|p| prefix_alive(&p, tokens, false))
+    {
+        return Some(Nearest {
+            candidate: None,
+            open: true,
+        });
+    }
     let mut best: Option<(Candidate, usize)> = None;
-    let mut open = false;
     for a in 0..lib.len() {
         let Some(p) = lib.pattern(a) else { continue };
-        open |= prefix_alive(&p, tokens, false);
         let aligned = n.max(p.min_len());
         // Within the share: cost ≤ FULL · aligned · e / t half-edits.
         let (e, t) = EDIT_SHARE;
@@ -127,7 +135,7 @@ pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) 
     }
     Some(Nearest {
         candidate: best.map(|(c, _)| c),
-        open,
+        open: false,
     })
 }
 
