@@ -124,13 +124,11 @@ impl<'a> Pattern<'a> {
     }
     /// Positions whose symbol is `t`.
     pub fn symbol_mask(&self, t: Token) -> u64 {
-        let mut m = 0u64;
-        for i in 1..=self.positions() {
-            if symbol_matches(self.symbol(i), t) {
-                m |= 1 << i;
-            }
-        }
-        m
+        self.symbols()
+            .enumerate()
+            .take(MAX_POSITIONS)
+            .filter(|&(_, s)| symbol_matches(s, t))
+            .fold(0, |m, (i, _)| m | (2u64 << i))
     }
     /// Whether the action is cyclic: its whole pattern repeats (walk, wave …), so a short
     /// pause does not end it.
