@@ -55,6 +55,15 @@ pub const PEAK_TAU_S: f32 = 1.0;
 pub const ARM_M: f32 = 0.1;
 /// Minimum duration of a token, µs.
 pub const MIN_TOKEN_US: u64 = 40_000;
+/// Ticks (10 ms each) of motion after stillness within which some bin must be confirmed. A
+/// quick stroke sweeps through bins faster than any one of them persists for [`MIN_TOKEN_US`]
+/// (a sudden sidestep hop passes `u`, `ru`, `r`, `rd` within 15 ticks); without this rule its
+/// ticks would all be merged into the STILL run before it and the gesture lost. After this
+/// many ticks without STILL and without a confirmed bin, the bin seen most often among them
+/// (the later one on a tie) opens the next run. Between two moving bins the rule does not
+/// apply: there a blip merged into the run before it keeps the gesture. Also the capacity of
+/// the tokenizer's record of those ticks (2 bytes each).
+pub const SWEEP_TICKS: usize = 8;
 /// Rotation angle (rad, ≈ 229°) about one axis, in one direction, after which the current run
 /// starts again as a new run of the same token: the string then tells a spin from a turn,
 /// while angles — unlike distances — do not depend on the doodle's size.
@@ -301,6 +310,9 @@ pub struct Tokenizer {
     current: Option<Token>,
     candidate: Option<(Token, u64)>,
     turned: [f32; 3],
+    /// Raw tokens of the ticks since the current token was last seen (first `swept`).
+    sweep: [Token; SWEEP_TICKS],
+    swept: usize,
 }
 
 impl Default for Tokenizer {
@@ -340,7 +352,23 @@ impl Tokenizer {
             current: None,
             candidate: None,
             turned: [0.0; 3],
+            sweep: [STILL; SWEEP_TICKS],
+            swept: 0,
         }
+    }
+
+    /// The token seen most often among the swept ticks (the later one on a tie).
+    fn sweep_mode(&self) -> Option<Token> {
+        let seen = self.sweep.get(..self.swept)?;
+        let mut best: Option<(Token, usize)> = None;
+        for (i, &t) in seen.iter().enumerate() {
+            let n = seen.iter().filter(|&&u| u == t).count();
+            let later = seen.get(i + 1..).is_some_and(|rest| rest.contains(&t));
+            if !later && best.is_none_or(|(_, m)| n >= m) {
+                best = Some((t, n));
+            }
+        }
+        best.map(|(t, _)| t)
     }
 
     /// The instantaneous (unsuppressed) token of a tick; updates the peak trackers.
@@ -386,6 +414,7 @@ impl Tokenizer {
             }
         }
         if raw == cur {
+            self.swept = 0;
             if chunk && self.candidate.is_none() && raw != STILL {
                 // A marker run opens; `current` stays the rotating token, so the marker run
                 // lasts while the rotation does (see `TURN`).
@@ -399,12 +428,27 @@ impl Tokenizer {
                 TokenStep::Run
             };
         }
+        if cur == STILL {
+            if let Some(slot) = self.sweep.get_mut(self.swept) {
+                *slot = raw;
+                self.swept += 1;
+            }
+        }
+        if self.swept >= SWEEP_TICKS {
+            if let Some(token) = self.sweep_mode() {
+                self.current = Some(token);
+                self.candidate = None;
+                self.swept = 0;
+                return TokenStep::NewToken { token };
+            }
+        }
         match self.candidate {
             Some((c, since)) if c == raw => {
                 // Confirm once the candidate spans MIN_TOKEN_US (counting this tick's period).
                 if now + TICK_US - since >= MIN_TOKEN_US {
                     self.current = Some(raw);
                     self.candidate = None;
+                    self.swept = 0;
                     TokenStep::NewToken { token: raw }
                 } else {
                     TokenStep::Candidate
@@ -522,5 +566,50 @@ mod tests {
             }
         );
         assert_eq!(tk.current(), parse_token("f"));
+    }
+
+    #[test]
+    fn a_quick_sweep_after_stillness_is_not_lost() {
+        let mut tk = Tokenizer::new();
+        let mut t = 0;
+        let mut feed = |tk: &mut Tokenizer, v: [f32; 3], n: u64| {
+            let mut out = std::vec::Vec::new();
+            for _ in 0..n {
+                out.push(tk.step(&kin(t, v, [0.0; 3])));
+                t += TICK_US;
+            }
+            out
+        };
+        feed(&mut tk, [0.0; 3], 5);
+        assert_eq!(tk.current(), Some(STILL));
+        // Up, up-right, right, down-right: no bin lasts MIN_TOKEN_US.
+        let (u, ru, r, rd) = (
+            [0.0, 1.0, 0.0],
+            [-0.7, 0.7, 0.0],
+            [-1.0, 0.0, 0.0],
+            [-0.7, -0.7, 0.0],
+        );
+        let mut steps = feed(&mut tk, u, 3);
+        steps.extend(feed(&mut tk, ru, 2));
+        steps.extend(feed(&mut tk, r, 3));
+        assert_eq!(
+            steps.last(),
+            Some(&TokenStep::NewToken {
+                token: parse_token("r").unwrap()
+            }),
+            "{steps:?}"
+        );
+        // Before the rule fires nothing was confirmed, and afterwards a blip merges as usual.
+        assert!(steps[..7]
+            .iter()
+            .all(|s| !matches!(s, TokenStep::NewToken { .. })));
+        feed(&mut tk, rd, 2);
+        assert_eq!(
+            feed(&mut tk, r, 1),
+            [TokenStep::BlipMerged {
+                starts_candidate: false
+            }]
+        );
+        assert_eq!(tk.current(), parse_token("r"));
     }
 }

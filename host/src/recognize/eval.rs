@@ -286,10 +286,22 @@ pub fn evaluate(
             } else {
                 if args.verbose {
                     let t = super::learn::tokenize_gesture(&d.log);
+                    let v = &d.variation;
                     eprintln!(
                         "{} -> {got}: {}",
                         l.action,
                         super::library::tokens_to_string(&super::learn::tokens_only(&t))
+                    );
+                    eprintln!(
+                        "    played at {:.0} Hz, scale {:.2}, speed {:.2}, noise {:.2}, {:?}/{:?} \
+                         (figurine synth examples --action {} --count 1 --seed {seed})",
+                        v.rate_hz,
+                        v.scale,
+                        v.speed,
+                        v.noise,
+                        l.time_class,
+                        l.weight_class,
+                        l.action
                     );
                     for e in &evs {
                         eprintln!(
