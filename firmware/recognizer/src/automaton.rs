@@ -17,8 +17,10 @@
 //! ```
 //! A match of cost v ends at this token when `D'[v]` meets the accepting set. Since match
 //! starts are not tracked in the masks (that would cost 32× the RAM), the start of a match is
-//! found when needed by running the reversed automaton backwards over the token history
-//! ([`earliest_start`]), which also picks the longest match at that cost.
+//! found when needed by running the reversed automaton backwards over the token history:
+//! [`earliest_start`] picks the longest match at the lowest cost, [`best_start`] the match a
+//! score prefers over all costs within the bound (the recognizer's merit: a longer match with
+//! a near substitution in it can outrank a short exact one).
 //! RAM: `MAX_ACTIONS × (2·MAX_EDITS + 1) × 8` = 1.75 KiB.
 
 use crate::alignment::{advance, masks, FULL};
@@ -108,8 +110,53 @@ pub fn prefix_alive(p: &Pattern<'_>, tokens: &[Token], skip_first: bool) -> bool
 pub fn earliest_start(
     p: &Pattern<'_>,
     max_cost: u8,
-    mut token_back: impl FnMut(usize) -> Option<Token>,
+    token_back: impl FnMut(usize) -> Option<Token>,
 ) -> Option<(usize, u8)> {
+    let mut found: Option<(usize, u8)> = None;
+    reverse_search(p, max_cost, token_back, |j, v| {
+        // The lowest cost wins; at equal cost the longest (latest j).
+        if found.is_none_or(|(_, fv)| v <= fv) {
+            found = Some((j, v));
+        }
+        // Higher levels can only find costlier starts.
+        v
+    });
+    found
+}
+
+/// Like [`earliest_start`], but of all the starts at costs `v ≤ max_cost` — for each cost the
+/// longest match — returns the one `score(j, v)` rates highest (`None` = not acceptable), and
+/// its score; on equal scores the cheaper. `bound(best)` is the highest cost that could still
+/// beat score `best` with any match the history allows (`j` grows by one per token read), so
+/// the search stops early.
+pub fn best_start(
+    p: &Pattern<'_>,
+    max_cost: u8,
+    token_back: impl FnMut(usize) -> Option<Token>,
+    mut score: impl FnMut(usize, u8) -> Option<i32>,
+    mut bound: impl FnMut(i32) -> u8,
+) -> Option<(usize, u8, i32)> {
+    let mut found: Option<(usize, u8, i32)> = None;
+    reverse_search(p, max_cost, token_back, |j, v| {
+        if let Some(s) = score(j, v) {
+            if found.is_none_or(|(_, fv, fs)| s > fs || (s == fs && v < fv)) {
+                found = Some((j, v, s));
+            }
+        }
+        found.map_or(max_cost, |(_, _, s)| bound(s))
+    });
+    found
+}
+
+/// The reversed automaton of `p` up to `max_cost` (and the pattern's own bound): calls
+/// `on_start(j, v)` whenever tokens `j..=0` match at cost `v` (level by level, `j` growing);
+/// it returns the highest level still worth searching.
+fn reverse_search(
+    p: &Pattern<'_>,
+    max_cost: u8,
+    mut token_back: impl FnMut(usize) -> Option<Token>,
+    mut on_start: impl FnMut(usize, u8) -> u8,
+) {
     // A virtual state after the accepting ones.
     const END: u64 = 1 << 63;
     let mut top = usize::from(max_cost).min(top_level(p));
@@ -130,39 +177,36 @@ pub fn earliest_start(
         let g = rev(n);
         (n1, g2, g1) = (n, g1, g);
     }
-    let mut found: Option<(usize, u8)> = None;
     let mut j = 0;
     while let Some(c) = token_back(j) {
         let (exact, near) = masks(p, c);
         let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
         let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
         let mut live = false;
-        for (v, slot) in d.iter_mut().enumerate().take(top + 1) {
+        let mut v = 0;
+        while v <= top {
+            let Some(slot) = d.get_mut(v) else { break };
             let old = *slot;
             let f0 = rev(old);
             let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
             *slot = new;
             live |= new != 0;
             // A match may start here, at a first position of the pattern (leading deletions
-            // are in `new` already: the backward deletion term).
+            // are in `new` already: the backward deletion term). Each level reports its
+            // longest start (a lower level's is reported first and stands at equal cost).
             if new & first != 0 {
-                // The lowest cost wins; at equal cost the longest (latest j).
-                if found.is_none_or(|(_, fv)| v as u8 <= fv) {
-                    found = Some((j, v as u8));
-                }
-                // Higher levels can only find costlier starts.
-                top = v;
+                top = top.min(usize::from(on_start(j, v as u8)));
             }
             let g0 = rev(new);
             (o2, o1, f2, f1) = (o1, old, f1, f0);
             (n1, g2, g1) = (new, g1, g0);
+            v += 1;
         }
         if !live {
             break;
         }
         j += 1;
     }
-    found
 }
 
 #[cfg(test)]
@@ -267,6 +311,25 @@ mod tests {
         assert_eq!(earliest_start(&p, 2, back), Some((2, 1)));
     }
 
+    #[test]
+    fn the_best_start_is_the_one_the_score_prefers() {
+        let blob = seq_library(&[(&["u", "f", "d"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        // `u f d` exactly, or `l u f d` with one insertion.
+        let stream = toks("l u f d");
+        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
+        let merit = |j: usize, v: u8| Some(4 * (j as i32 + 1) - 3 * i32::from(v));
+        assert_eq!(best_start(&p, 2, back, merit, |_| 2), Some((2, 0, 12)));
+        let longest = |j: usize, _: u8| Some(j as i32);
+        assert_eq!(best_start(&p, 2, back, longest, |_| 2), Some((3, 2, 3)));
+        // Refused starts are not taken (`u f d` here); once one is found, the bound on what
+        // could beat it ends the search (only `f d`, a deletion, is then seen).
+        let costly = |j: usize, v: u8| (v > 0).then_some(j as i32);
+        assert_eq!(best_start(&p, 2, back, costly, |_| 2), Some((3, 2, 3)));
+        assert_eq!(best_start(&p, 2, back, costly, |_| 0), Some((1, 2, 1)));
+    }
+
     use proptest::prelude::*;
 
     proptest! {
@@ -301,6 +364,16 @@ mod tests {
                     (0..=end).find(|&s| costs[s] == Some(b)).map(|s| (end - s, b))
                 });
                 prop_assert_eq!(found, longest, "end {}", end);
+                // The best-scoring start: the brute force over every start and its cost.
+                let score = |j: usize, v: u8| Some(4 * (j as i32 + 1) - 3 * i32::from(v));
+                let brute = costs
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(s, c)| c.and_then(|c| Some((end - s, c, score(end - s, c)?))))
+                    .max_by_key(|&(_, c, sc)| (sc, core::cmp::Reverse(c)));
+                let bound = |best: i32| ((4 * (end as i32 + 1) - best - 1).max(0) / 3) as u8;
+                let found = best_start(&p, top, back, score, bound);
+                prop_assert_eq!(found.map(|f| (f.1, f.2)), brute.map(|b| (b.1, b.2)), "end {}", end);
             }
         }
     }

@@ -7,7 +7,7 @@
 //! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
 //! all (14,440 B by `size_of`, measured by a test) with 32 actions loaded.
 
-use crate::automaton::{earliest_start, prefix_alive, MatcherBank, Matches};
+use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
 use crate::frontend::{FrontEvent, Frontend};
@@ -16,8 +16,8 @@ use crate::intake::{IntakeCounters, Sample};
 use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, HOLD_BACK_TOKENS,
-    INEXACT_HOLD_US, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, GAPPED_HOLD_US,
+    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -194,7 +194,7 @@ impl<'lib> Recognizer<'lib> {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
                 let longer = match (self.decider.pending(), newest) {
-                    (Some(p), Some(run)) if (PAUSE_US..INEXACT_HOLD_US).contains(&still) => {
+                    (Some(p), Some(run)) if (PAUSE_US..GAPPED_HOLD_US).contains(&still) => {
                         match self.hold {
                             Some((r, v)) if r == run => v,
                             _ => {
@@ -416,14 +416,21 @@ impl<'lib> Recognizer<'lib> {
             let Some(p) = self.library.pattern(a) else {
                 continue;
             };
-            // Lowest cost first, then the longest match at that cost; held to the share of
-            // edits per token (in half-edits) as well as to the action's bound.
-            let Some((j, cost)) = earliest_start(&p, d, back) else {
+            // The match of the highest merit ending here, up to the action's bound: a costlier
+            // but longer one can rank higher (a run's strides with a wobble among them, against
+            // the few exact ones after it). Held to the share of edits per token (in
+            // half-edits) as well as to the action's bound.
+            let min_len = p.min_len();
+            let longest = n.saturating_sub(1);
+            let Some((j, cost, _)) = best_start(
+                &p,
+                top_level(&p).min(255) as u8,
+                back,
+                |j, v| edits_fit(v, (j + 1).max(min_len)).then(|| Candidate::merit_of(j + 1, v)),
+                |best| Candidate::max_cost_beating(best, longest + 1),
+            ) else {
                 continue;
             };
-            if !edits_fit(cost, (j + 1).max(p.min_len())) {
-                continue;
-            }
             let c = Candidate {
                 action: a as u8,
                 start: idx.get(j).copied().unwrap_or(end),

@@ -1,8 +1,9 @@
 //! Stage 6 — online segment decision: when to commit which action.
 //!
 //! Each token that completes one or more approximate matches yields candidates (action, first
-//! and last run, weighted cost, length in tokens). A pending candidate is replaced by an overlapping
-//! one of higher merit `4·length − 3·cost`, the cost in half-edits
+//! and last run, weighted cost, length in tokens): per action the match ending there of the
+//! highest merit `4·length − 3·cost` within its bound. A pending candidate is replaced by an
+//! overlapping one of higher merit, the cost in half-edits
 //! ([`crate::alignment`]: a token that differs from the pattern only in its
 //! rotation, or by 45° in its direction, costs half an edit) — near-ties go to the longest
 //! action, as in seed 000 §7.5, and an action that keeps extending (a walk of several hops)
@@ -11,14 +12,16 @@
 //! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
 //! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
 //!   whose pattern repeats as a whole; up to [`HOLD_US`] — [`INEXACT_HOLD_US`] when it
-//!   needed edits — while another action has matched further than it exactly and may go on
-//!   after the hold), or
+//!   needed near substitutions, [`GAPPED_HOLD_US`] when it needed a whole edit — while another
+//!   action has matched further than it exactly and may go on after the hold), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
 //! the look-ahead are replayed), so segments never overlap. A gesture that stands alone and
 //! that no action matched within its bound is offered to [`crate::nearest`] once the figurine
 //! has paused after it.
+
+use crate::alignment::FULL;
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
 pub const LOOKAHEAD_TOKENS: u8 = 4;
@@ -41,6 +44,11 @@ pub const HOLD_US: u64 = 500_000;
 /// further exactly may go on, an inexact match is the weaker reading of a long hold (a crouch
 /// held low, whose downward strokes a jump also explains by leaving out its rise).
 pub const INEXACT_HOLD_US: u64 = 1_000_000;
+/// [`HOLD_US`] for a pending candidate that needed a whole edit or more (a stroke left out or
+/// added, not just a near substitution), µs: a crouch held low for a second or more, whose
+/// downward strokes a jump explains by leaving out its rise, while the crouch that matches
+/// exactly once the figurine rises is still under way.
+pub const GAPPED_HOLD_US: u64 = 2_000_000;
 /// Edits a match may spend per token it covers, as (edits, tokens): 2 per 5. A pattern's own
 /// bound (up to [`crate::pattern::MAX_EDITS`]) caps the total; this share keeps a short match
 /// from being mostly edits, so the bound can be generous for long performances without
@@ -85,13 +93,25 @@ pub struct Candidate {
 impl Candidate {
     /// Edit distance in whole edits, rounded up: what an event reports.
     pub fn distance(&self) -> u8 {
-        self.cost.div_ceil(crate::alignment::FULL)
+        self.cost.div_ceil(FULL)
     }
 
     /// Ranking score, in quarter tokens: longer is better, each edit costs 1.5 tokens
     /// (a rotation-only disagreement half of that).
     pub fn merit(&self) -> i32 {
-        4 * i32::from(self.len) - 3 * i32::from(self.cost)
+        Self::merit_of(usize::from(self.len), self.cost)
+    }
+
+    /// [`Candidate::merit`] of a match over `len` tokens at `cost` half-edits.
+    pub fn merit_of(len: usize, cost: u8) -> i32 {
+        4 * (len.min(u16::MAX as usize) as i32) - 3 * i32::from(cost)
+    }
+
+    /// The highest cost at which a match of at most `max_len` tokens can still have a merit
+    /// above `merit` (0 when none can).
+    pub fn max_cost_beating(merit: i32, max_len: usize) -> u8 {
+        let top = Self::merit_of(max_len, 0) - merit - 1;
+        (top.max(0) / 3).min(255) as u8
     }
 
     /// True when `self` should replace `other`: higher merit; at equal merit the more
@@ -180,7 +200,8 @@ impl Decider {
     }
 
     /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`] —
-    /// or after [`HOLD_US`] ([`INEXACT_HOLD_US`] if the pending candidate needed edits) while
+    /// or after [`HOLD_US`] ([`INEXACT_HOLD_US`] if the pending candidate needed a near
+    /// substitution, [`GAPPED_HOLD_US`] if it needed a whole edit) while
     /// `longer_in_progress` (a longer action has matched further than the pending one and may
     /// go on after the hold).
     pub fn stillness(&mut self, still_us: u64, longer_in_progress: bool) -> Decision {
@@ -188,7 +209,13 @@ impl Decider {
             return Decision::Wait;
         };
         let pause = if p.cyclic { CYCLIC_PAUSE_US } else { PAUSE_US };
-        let hold = if p.cost > 0 { INEXACT_HOLD_US } else { HOLD_US };
+        let hold = if p.cost >= FULL {
+            GAPPED_HOLD_US
+        } else if p.cost > 0 {
+            INEXACT_HOLD_US
+        } else {
+            HOLD_US
+        };
         if still_us >= pause && (still_us >= hold || !longer_in_progress) {
             Decision::Commit(p)
         } else {
@@ -286,19 +313,26 @@ mod tests {
         d.offer(Some(c(0, 2, 3, 0)), 0);
         assert_eq!(d.stillness(PAUSE_US, true), Decision::Wait);
         assert_eq!(d.stillness(HOLD_US, true), Decision::Commit(c(0, 2, 3, 0)));
-        // An inexact pending candidate is the weaker reading of a long hold: it waits longer.
+        // An inexact pending candidate is the weaker reading of a long hold: it waits longer,
+        // the longer the more it needed.
         let mut d = Decider::new();
         d.offer(Some(c(0, 1, 3, 1)), 0);
         assert_eq!(d.stillness(HOLD_US, true), Decision::Wait);
-        assert_eq!(d.stillness(INEXACT_HOLD_US - 1, true), Decision::Wait);
+        assert_eq!(d.stillness(GAPPED_HOLD_US - 1, true), Decision::Wait);
         assert_eq!(
-            d.stillness(INEXACT_HOLD_US, true),
+            d.stillness(GAPPED_HOLD_US, true),
             Decision::Commit(c(0, 1, 3, 1))
         );
         assert_eq!(
             d.stillness(PAUSE_US, false),
             Decision::Commit(c(0, 1, 3, 1))
         );
+        let mut near = c(0, 1, 3, 0);
+        near.cost = 1;
+        let mut d = Decider::new();
+        d.offer(Some(near), 0);
+        assert_eq!(d.stillness(INEXACT_HOLD_US - 1, true), Decision::Wait);
+        assert_eq!(d.stillness(INEXACT_HOLD_US, true), Decision::Commit(near));
     }
 
     #[test]

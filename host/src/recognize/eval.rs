@@ -87,6 +87,15 @@ pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<Library
         let logs: Vec<_> = docs.into_iter().map(|d| d.log).collect();
         lib.upsert(learn_action(action.name(), &logs, None, true)?);
     }
+    for step in super::separate::separate(&mut lib)? {
+        eprintln!(
+            "  narrowed `{}`: {}  ->  {}  (no longer accepts exactly {})",
+            step.action,
+            step.from,
+            step.to,
+            step.no_longer.join(", ")
+        );
+    }
     Ok(lib)
 }
 

@@ -18,6 +18,9 @@
 //!    column — or mandatory columns when every example has the same optional sequence there.
 //! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
 //!    three tokens of the shortest match.
+//! 7. Against the rest of the library ([`super::separate`]): a pattern that accepts another
+//!    action's example exactly is narrowed until it does not (or cannot be without losing its
+//!    own examples).
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -808,6 +811,14 @@ pub fn run(args: &LearnArgs) -> Result<()> {
         entry.name, entry.regex, entry.max_edits
     );
     lib.upsert(entry);
+    for step in super::separate::separate(&mut lib)? {
+        eprintln!(
+            "narrowed `{}` to `{}`: it accepted {} exactly",
+            step.action,
+            step.to,
+            step.no_longer.join(", ")
+        );
+    }
     lib.write(&args.library)?;
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! - [`feed`]: logs → wire-quantised samples → recognizer / front end.
 //! - [`regex`]: pattern sources → Glushkov automata → device records.
 //! - [`library`] / [`effort_model`]: LIB.json and EFFORT.json, and their device blobs.
-//! - [`dtw`] + [`learn`]: `figurine learn`.
+//! - [`dtw`] + [`learn`] + [`separate`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ [`font`]): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
 //! - [`eval`] (+ [`eval_pairs`]): `figurine eval`.
@@ -19,5 +19,6 @@ pub mod learn;
 pub mod library;
 pub mod regex;
 pub mod report;
+pub mod separate;
 pub mod simulate;
 pub mod tokens;

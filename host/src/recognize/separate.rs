@@ -1,0 +1,350 @@
+//! Learning against the rest of the library: no action's pattern should accept another
+//! action's examples without an edit.
+//!
+//! Each action is learnt from its own few examples ([`super::learn`]), which leaves its
+//! pattern as general as those examples allow: a stroke seen with a small pitch is written
+//! with and without it (`f.Xn|f|f.Xp`), a part some example lacks becomes optional. Two
+//! actions learnt that way can overlap — a kick whose pitch was small accepts a punch's
+//! `b f b` exactly — and the recognizer then has only tie-breaks to tell them apart.
+//!
+//! [`separate`] narrows such a pattern until it no longer accepts any example of another
+//! action exactly. A narrowing step takes a stroke's plain variant out of an alternation of
+//! its rotated ones (`f.Xn|f|f.Xp` → `f.Xn|f.Xp`): the rotation is then part of the gesture,
+//! and a plain `f` still matches, at a near substitution's half edit. So an exact tie between
+//! two actions becomes a half-edit preference.
+//!
+//! A step is taken only when every example of the narrowed action still matches at a cost no
+//! higher than before, and it is the one that leaves the fewest exact matches of other
+//! actions' examples (then the fewest matches at all). A pattern written as a mirrored pair
+//! (`A|A'`) is narrowed at the same place on both sides. The edit bound stays as learnt.
+//!
+//! Optional groups are not made mandatory: that can make a pattern win ties it should not
+//! (`d+ u+ (u~)*` → `d+ u+ (u~)+` is a longer shortest match, so it outranks a crouch's
+//! `d+ u+` on a crouch that rises in two strokes).
+
+use anyhow::Result;
+use figurine_recognizer::token::{Symbol, ANY_LIN, ANY_ROT, NONE_BIN};
+
+use super::learn::full_match;
+use super::library::{parse_tokens, ActionEntry, LibraryFile};
+use super::regex::Regex;
+
+/// Narrowing steps [`separate`] takes at most over a whole library.
+pub const MAX_STEPS: usize = 32;
+
+/// One narrowing step taken: which action, and its pattern before and after.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Narrowed {
+    /// The narrowed action.
+    pub action: String,
+    /// Its pattern before.
+    pub from: String,
+    /// Its pattern after.
+    pub to: String,
+    /// Examples of other actions it accepted exactly before, as `action: tokens`.
+    pub no_longer: Vec<String>,
+}
+
+/// Whether `s` is a plain stroke (translation, no rotation, no wildcard).
+fn plain(s: Symbol) -> bool {
+    s & (ANY_LIN | ANY_ROT) == 0 && s / 27 != NONE_BIN && s % 27 == NONE_BIN
+}
+
+/// Whether `s` is the stroke `lin` with a rotation (no wildcard).
+fn rotated_of(s: Symbol, lin: Symbol) -> bool {
+    s & (ANY_LIN | ANY_ROT) == 0 && s / 27 == lin && s % 27 != NONE_BIN
+}
+
+/// Number of narrowing sites in `re` (pre-order): alternations of plain and rotated variants
+/// of one stroke.
+fn sites(re: &Regex) -> usize {
+    let own = usize::from(is_site(re));
+    own + match re {
+        Regex::Sym(_) => 0,
+        Regex::Cat(v) | Regex::Alt(v) => v.iter().map(sites).sum(),
+        Regex::Star(r) | Regex::Plus(r) | Regex::Opt(r) => sites(r),
+    }
+}
+
+fn is_site(re: &Regex) -> bool {
+    matches!(re, Regex::Alt(v) if plain_with_rotated(v).is_some())
+}
+
+/// The index of the plain stroke in an alternation that also has it rotated.
+fn plain_with_rotated(v: &[Regex]) -> Option<usize> {
+    v.iter().position(|r| match r {
+        Regex::Sym(p) if plain(*p) => v
+            .iter()
+            .any(|o| matches!(o, Regex::Sym(s) if rotated_of(*s, p / 27))),
+        _ => false,
+    })
+}
+
+/// `re` with site `k` (pre-order, see [`sites`]) narrowed; `k` counts down as sites pass.
+fn narrow_at(re: &Regex, k: &mut usize) -> Regex {
+    if is_site(re) {
+        if *k == 0 {
+            *k = usize::MAX;
+            return match re {
+                Regex::Alt(v) => {
+                    let skip = plain_with_rotated(v);
+                    let mut rest: Vec<Regex> = v
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| Some(*i) != skip)
+                        .map(|(_, r)| r.clone())
+                        .collect();
+                    match rest.len() {
+                        1 => rest.remove(0),
+                        _ => Regex::Alt(rest),
+                    }
+                }
+                other => other.clone(),
+            };
+        }
+        if *k != usize::MAX {
+            *k -= 1;
+        }
+    }
+    match re {
+        Regex::Sym(s) => Regex::Sym(*s),
+        Regex::Cat(v) => Regex::Cat(v.iter().map(|r| narrow_at(r, k)).collect()),
+        Regex::Alt(v) => Regex::Alt(v.iter().map(|r| narrow_at(r, k)).collect()),
+        Regex::Star(r) => Regex::Star(Box::new(narrow_at(r, k))),
+        Regex::Plus(r) => Regex::Plus(Box::new(narrow_at(r, k))),
+        Regex::Opt(r) => Regex::Opt(Box::new(narrow_at(r, k))),
+    }
+}
+
+/// Every one-step narrowing of `re`; a mirrored pair `A|A'` (two alternatives with as many
+/// sites) is narrowed at the same site on both sides.
+fn narrowings(re: &Regex) -> Vec<Regex> {
+    if let Regex::Alt(v) = re {
+        if let [a, b] = v.as_slice() {
+            let n = sites(a);
+            if n > 0 && n == sites(b) {
+                return (0..n)
+                    .map(|k| {
+                        Regex::Alt(vec![
+                            narrow_at(a, &mut k.clone()),
+                            narrow_at(b, &mut k.clone()),
+                        ])
+                    })
+                    .collect();
+            }
+        }
+    }
+    (0..sites(re))
+        .map(|k| narrow_at(re, &mut k.clone()))
+        .collect()
+}
+
+/// Every example of every action, as (action index, source text, tokens).
+type Examples = Vec<(usize, String, Vec<figurine_recognizer::token::Token>)>;
+
+fn all_examples(lib: &LibraryFile) -> Result<Examples> {
+    let mut out = Vec::new();
+    for (i, a) in lib.actions.iter().enumerate() {
+        for ex in &a.examples {
+            out.push((i, ex.clone(), parse_tokens(ex)?));
+        }
+    }
+    Ok(out)
+}
+
+/// How much a pattern overlaps the other actions' examples.
+#[derive(Debug, Clone, Default)]
+struct Overlap {
+    /// Examples it matches exactly.
+    exact: usize,
+    /// Examples it matches within its bound.
+    any: usize,
+    /// The exactly matched ones: (action index, example).
+    which: Vec<(usize, String)>,
+}
+
+impl Overlap {
+    fn rank(&self) -> (usize, usize) {
+        (self.exact, self.any)
+    }
+}
+
+/// How much `entry` (action `own`) overlaps the other actions' examples.
+fn overlap(entry: &ActionEntry, own: usize, ex: &Examples) -> Result<Overlap> {
+    let mut o = Overlap::default();
+    for (a, src, t) in ex.iter().filter(|(a, _, _)| *a != own) {
+        match full_match(entry, t)? {
+            Some(0) => {
+                o.exact += 1;
+                o.any += 1;
+                o.which.push((*a, src.clone()));
+            }
+            Some(_) => o.any += 1,
+            None => {}
+        }
+    }
+    Ok(o)
+}
+
+/// Whether `cand` still matches every example of action `own` at no higher cost than
+/// `before` did.
+fn keeps_own(cand: &ActionEntry, own: usize, ex: &Examples, before: &[Option<u8>]) -> Result<bool> {
+    for ((_, _, t), was) in ex.iter().filter(|(a, _, _)| *a == own).zip(before) {
+        let now = full_match(cand, t)?;
+        let kept = match (was, now) {
+            (Some(w), Some(n)) => n <= *w,
+            (None, _) => true,
+            (Some(_), None) => false,
+        };
+        if !kept {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// Narrows the patterns of `lib` until none accepts another action's example exactly, or no
+/// step helps (see the module docs). Returns the steps taken, in order.
+pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
+    let ex = all_examples(lib)?;
+    let mut steps = Vec::new();
+    let mut stuck = vec![false; lib.actions.len()];
+    while steps.len() < MAX_STEPS {
+        // The action that accepts the most foreign examples exactly.
+        let mut worst: Option<(usize, Overlap)> = None;
+        for (i, a) in lib.actions.iter().enumerate() {
+            if stuck[i] {
+                continue;
+            }
+            let o = overlap(a, i, &ex)?;
+            if o.exact > 0 && worst.as_ref().is_none_or(|(_, w)| o.exact > w.exact) {
+                worst = Some((i, o));
+            }
+        }
+        let Some((i, before)) = worst else { break };
+        let entry = &lib.actions[i];
+        let own_costs: Vec<Option<u8>> = ex
+            .iter()
+            .filter(|(a, _, _)| *a == i)
+            .map(|(_, _, t)| full_match(entry, t))
+            .collect::<Result<_>>()?;
+        let mut best: Option<(ActionEntry, Overlap)> = None;
+        for re in narrowings(&Regex::parse(&entry.regex)?) {
+            let Ok(cand) = ActionEntry::new(
+                &entry.name,
+                &re.to_source(),
+                Some(entry.max_edits),
+                entry.examples.clone(),
+            ) else {
+                continue;
+            };
+            if !keeps_own(&cand, i, &ex, &own_costs)? {
+                continue;
+            }
+            let o = overlap(&cand, i, &ex)?;
+            let better =
+                o.rank() < before.rank() && best.as_ref().is_none_or(|(_, b)| o.rank() < b.rank());
+            if better {
+                best = Some((cand, o));
+            }
+        }
+        match best {
+            Some((cand, after)) if after.exact < before.exact => {
+                let no_longer = before
+                    .which
+                    .iter()
+                    .filter(|w| !after.which.contains(w))
+                    .map(|(a, src)| format!("{}: {src}", lib.actions[*a].name))
+                    .collect();
+                steps.push(Narrowed {
+                    action: cand.name.clone(),
+                    from: lib.actions[i].regex.clone(),
+                    to: cand.regex.clone(),
+                    no_longer,
+                });
+                lib.actions[i] = cand;
+            }
+            _ => stuck[i] = true,
+        }
+    }
+    Ok(steps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(name: &str, re: &str, edits: u8, examples: &[&str]) -> ActionEntry {
+        ActionEntry::new(
+            name,
+            re,
+            Some(edits),
+            examples.iter().map(|s| s.to_string()).collect(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn sites_are_plain_strokes_among_their_rotations() {
+        let re = Regex::parse("b* (f.Xn|f|f.Xp)+ (b|.Xp)* (b|b.Zn)+ (d|f.Xn)").unwrap();
+        assert_eq!(sites(&re), 2);
+        let all: Vec<String> = narrowings(&re).iter().map(Regex::to_source).collect();
+        assert_eq!(
+            all,
+            [
+                "b* (f.Xn|f.Xp)+ (b|.Xp)* (b|b.Zn)+ (d|f.Xn)",
+                "b* (f.Xn|f|f.Xp)+ (b|.Xp)* b.Zn+ (d|f.Xn)",
+            ]
+        );
+        // A mirrored pair is narrowed on both sides at once.
+        let pair = Regex::parse("(lu|lu.Zn)+ l*|(ru|ru.Zp)+ r*").unwrap();
+        let all: Vec<String> = narrowings(&pair).iter().map(Regex::to_source).collect();
+        assert_eq!(all, ["lu.Zn+ l*|ru.Zp+ r*"]);
+    }
+
+    #[test]
+    fn a_kick_that_accepts_a_punch_loses_its_plain_stroke() {
+        let mut lib = LibraryFile::default();
+        lib.upsert(entry(
+            "punch",
+            "b* (f.Zn|f|f.Zp)+ b+",
+            1,
+            &["b f b", "f.Zp b"],
+        ));
+        lib.upsert(entry(
+            "kick",
+            "b* (f.Xn|f|f.Xp)+ (b.Xn|b|b.Xp)+ db*",
+            1,
+            &["b f.Xn b.Xp db", "f.Xn b.Xp", "b f.Xp b"],
+        ));
+        let steps = separate(&mut lib).unwrap();
+        assert_eq!(steps.len(), 1, "{steps:?}");
+        assert_eq!(steps[0].action, "kick");
+        assert_eq!(steps[0].no_longer, ["punch: b f b"]);
+        let kick = &lib.actions[1];
+        assert_eq!(kick.regex, "b* (f.Xn|f.Xp)+ (b.Xn|b|b.Xp)+ db*");
+        // Its own examples still match exactly; the punch's now needs half an edit.
+        for ex in &kick.examples {
+            assert_eq!(
+                full_match(kick, &parse_tokens(ex).unwrap()).unwrap(),
+                Some(0)
+            );
+        }
+        assert_eq!(
+            full_match(kick, &parse_tokens("b f b").unwrap()).unwrap(),
+            Some(1)
+        );
+        // Nothing left to separate: a second pass changes nothing.
+        assert!(separate(&mut lib).unwrap().is_empty());
+    }
+
+    #[test]
+    fn a_pattern_is_left_alone_when_narrowing_would_lose_its_own_examples() {
+        let mut lib = LibraryFile::default();
+        lib.upsert(entry("crouch", "d+ u+", 1, &["d u"]));
+        lib.upsert(entry("jump", "(d|d.Xp)+ u+ d*", 1, &["d u d", "d u"]));
+        let before = lib.actions[1].regex.clone();
+        assert!(separate(&mut lib).unwrap().is_empty());
+        assert_eq!(lib.actions[1].regex, before);
+    }
+}
