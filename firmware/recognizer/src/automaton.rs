@@ -183,6 +183,7 @@ fn reverse_search(
         let (mut o1, mut o2, mut f1, mut f2) = (0u64, 0u64, 0u64, 0u64);
         let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
         let mut live = false;
+        let mut started = false;
         let mut v = 0;
         while v <= top {
             let Some(slot) = d.get_mut(v) else { break };
@@ -193,8 +194,10 @@ fn reverse_search(
             live |= new != 0;
             // A match may start here, at a first position of the pattern (leading deletions
             // are in `new` already: the backward deletion term). Each level reports its
-            // longest start (a lower level's is reported first and stands at equal cost).
-            if new & first != 0 {
+            // longest start (a lower level's is reported first and stands at equal cost). The
+            // levels are monotone: a start here is one at every higher level too, dominated.
+            if !started && new & first != 0 {
+                started = true;
                 top = top.min(usize::from(on_start(j, v as u8)));
             }
             let g0 = rev(new);

@@ -130,7 +130,8 @@ const SCALE_KIND: [u8; QUANTITIES] = [
     1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3, 1, 1,
 ];
 
-/// The log-domain, scale-free features of a segment: means (see [`SCALE_KIND`]), then
+/// The log-domain, scale-free features of a segment: means (each divided or multiplied by its
+/// scale, so that size does not matter; the mean world speed stays absolute), then
 /// coefficients of variation.
 pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
     let mut out = [fmath::ln(FEATURE_EPS); FEATURES];

@@ -24,6 +24,7 @@
 //! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 7 × 8 B = 1.75 KiB of automaton state (half-edit levels) |
 //! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.7 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
+//! | [`token::SWEEP_TICKS`] | 8 ticks of a quick stroke after stillness | 16 B |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
 //! | [`alignment::MAX_COST`] | 23 half-edits | 192 B of stack while a candidate is weighed |
 //! | [`nearest::NEAREST_MAX_TOKENS`] | 24 tokens per stand-alone phrase | 96 B of stack |

@@ -5,7 +5,7 @@
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
 //! effort model 0.6 KiB, the last cyclic event (open to continuation), the state before a
 //! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
-//! all (14,440 B by `size_of`, measured by a test) with 32 actions loaded.
+//! all (14,464 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
@@ -416,15 +416,19 @@ impl<'lib> Recognizer<'lib> {
             let Some(p) = self.library.pattern(a) else {
                 continue;
             };
-            // The match of the highest merit ending here, up to the action's bound: a costlier
-            // but longer one can rank higher (a run's strides with a wobble among them, against
-            // the few exact ones after it). Held to the share of edits per token (in
+            // The match of the highest merit ending here at the lowest cost `d` — or, for a
+            // cyclic action, at one half-edit more: a run's many strides with a wobble among
+            // them outrank the few exact ones after it (and a walk's piece of them). Wider
+            // searches recognised no better and cost the MCU more (mean instructions per sample
+            // at 32 actions: every cost up to the bound 5,421, half an edit more for every
+            // action 5,095, this 4,890; goal 5,000). Held to the share of edits per token (in
             // half-edits) as well as to the action's bound.
             let min_len = p.min_len();
             let longest = n.saturating_sub(1);
+            let reach = usize::from(d) + usize::from(p.cyclic());
             let Some((j, cost, _)) = best_start(
                 &p,
-                top_level(&p).min(255) as u8,
+                reach.min(top_level(&p)).min(255) as u8,
                 back,
                 |j, v| edits_fit(v, (j + 1).max(min_len)).then(|| Candidate::merit_of(j + 1, v)),
                 |best| Candidate::max_cost_beating(best, longest + 1),

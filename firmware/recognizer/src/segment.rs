@@ -1,11 +1,12 @@
 //! Stage 6 — online segment decision: when to commit which action.
 //!
 //! Each token that completes one or more approximate matches yields candidates (action, first
-//! and last run, weighted cost, length in tokens): per action the match ending there of the
-//! highest merit `4·length − 3·cost` within its bound. A pending candidate is replaced by an
-//! overlapping one of higher merit, the cost in half-edits
-//! ([`crate::alignment`]: a token that differs from the pattern only in its
-//! rotation, or by 45° in its direction, costs half an edit) — near-ties go to the longest
+//! and last run, weighted cost, length in tokens): per action the longest match ending there
+//! at the lowest cost (for a cyclic action, the one of the highest merit within half an edit
+//! more). A pending candidate is replaced by an overlapping one of higher merit
+//! `4·length − 3·cost`, the cost in half-edits ([`crate::alignment`]: a token that differs
+//! from the pattern only in its rotation, or by 45° in its direction, costs half an edit) —
+//! near-ties go to the longest
 //! action, as in seed 000 §7.5, and an action that keeps extending (a walk of several hops)
 //! grows instead of being cut. The pending candidate is committed when
 //! - a candidate appears that starts after it (the next action has begun),
