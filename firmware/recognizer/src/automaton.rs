@@ -148,9 +148,9 @@ pub fn best_start(
     found
 }
 
-/// The reversed automaton of `p` up to `max_cost` (and the pattern's own bound): calls
-/// `on_start(j, v)` whenever tokens `j..=0` match at cost `v` (level by level, `j` growing);
-/// it returns the highest level still worth searching.
+/// The reversed automaton of `p` up to `max_cost` (and the pattern's own bound): for each `j`
+/// (growing) at which tokens `j..=0` match, calls `on_start(j, v)` with the lowest cost `v`
+/// of that match; it returns the highest level still worth searching.
 fn reverse_search(
     p: &Pattern<'_>,
     max_cost: u8,

@@ -6,9 +6,9 @@
 //! more). A pending candidate is replaced by an overlapping one of higher merit
 //! `4·length − 3·cost`, the cost in half-edits ([`crate::alignment`]: a token that differs
 //! from the pattern only in its rotation, or by 45° in its direction, costs half an edit) —
-//! near-ties go to the longest
-//! action, as in seed 000 §7.5, and an action that keeps extending (a walk of several hops)
-//! grows instead of being cut. The pending candidate is committed when
+//! near-ties go to the longest action, as in seed 000 §7.5, and an action that keeps
+//! extending (a walk of several hops) grows instead of being cut. The pending candidate is
+//! committed when
 //! - a candidate appears that starts after it (the next action has begun),
 //! - [`LOOKAHEAD_TOKENS`] tokens have passed after its end without a better overlapping one,
 //! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action

@@ -310,7 +310,8 @@ pub struct Tokenizer {
     current: Option<Token>,
     candidate: Option<(Token, u64)>,
     turned: [f32; 3],
-    /// Raw tokens of the ticks since the current token was last seen (first `swept`).
+    /// Raw tokens of the moving ticks since the current STILL run was last seen (the first
+    /// `swept`; recorded only while the current run is STILL).
     sweep: [Token; SWEEP_TICKS],
     swept: usize,
 }
