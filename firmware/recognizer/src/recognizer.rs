@@ -420,9 +420,9 @@ impl<'lib> Recognizer<'lib> {
             // cyclic action, at one half-edit more: a run's many strides with a wobble among
             // them outrank the few exact ones after it (and a walk's piece of them). Wider
             // searches recognised no better and cost the MCU more (mean instructions per sample
-            // at 32 actions: every cost up to the bound 5,421, half an edit more for every
-            // action 5,095, this 4,890; goal 5,000). Held to the share of edits per token (in
-            // half-edits) as well as to the action's bound.
+            // at 32 actions: every cost up to the bound 5,216, half an edit more for every
+            // action 4,977, this 4,829–4,850; goal 5,000). Held to the share of edits per token
+            // (in half-edits) as well as to the action's bound.
             let min_len = p.min_len();
             let longest = n.saturating_sub(1);
             let reach = usize::from(d) + usize::from(p.cyclic());
