@@ -233,6 +233,11 @@ mod tests {
             .collect()
     }
 
+    /// Token `j` back from the end of `stream` (what the reverse searches read).
+    fn backwards(stream: &[Token]) -> impl Fn(usize) -> Option<Token> + Copy + '_ {
+        move |j| stream.len().checked_sub(j + 1).map(|i| stream[i])
+    }
+
     #[test]
     fn exact_match_anywhere_in_the_stream() {
         let blob = seq_library(&[(&["u", "f", "d"], 0)]);
@@ -274,9 +279,8 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         let p = lib.pattern(0).unwrap();
         let stream = toks("f b");
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 2, back), Some((1, 2)));
-        assert_eq!(earliest_start(&p, 1, back), None);
+        assert_eq!(earliest_start(&p, 2, backwards(&stream)), Some((1, 2)));
+        assert_eq!(earliest_start(&p, 1, backwards(&stream)), None);
     }
 
     #[test]
@@ -299,19 +303,14 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         let p = lib.pattern(0).unwrap();
         let stream = toks("b u f d");
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 0, back), Some((2, 0)));
+        assert_eq!(earliest_start(&p, 0, backwards(&stream)), Some((2, 0)));
         // With one edit allowed, the extra leading `b` is not taken when it costs more.
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 2, back), Some((2, 0)));
+        assert_eq!(earliest_start(&p, 2, backwards(&stream)), Some((2, 0)));
         let stream = toks("u f l d");
-        let stream: Vec<Token> = stream;
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 2, back), Some((3, 2)));
+        assert_eq!(earliest_start(&p, 2, backwards(&stream)), Some((3, 2)));
         // A near token costs half an edit at the start too.
         let stream = toks("uf f d");
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
-        assert_eq!(earliest_start(&p, 2, back), Some((2, 1)));
+        assert_eq!(earliest_start(&p, 2, backwards(&stream)), Some((2, 1)));
     }
 
     #[test]
@@ -321,7 +320,7 @@ mod tests {
         let p = lib.pattern(0).unwrap();
         // `u f d` exactly, or `l u f d` with one insertion.
         let stream = toks("l u f d");
-        let back = |j: usize| stream.len().checked_sub(j + 1).map(|i| stream[i]);
+        let back = backwards(&stream);
         let merit = |j: usize, v: u8| Some(4 * (j as i32 + 1) - 3 * i32::from(v));
         assert_eq!(best_start(&p, 2, back, merit, |_| 2), Some((2, 0, 12)));
         let longest = |j: usize, _: u8| Some(j as i32);

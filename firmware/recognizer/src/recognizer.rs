@@ -424,14 +424,13 @@ impl<'lib> Recognizer<'lib> {
             // action 4,977, this 4,829–4,850; goal 5,000). Held to the share of edits per token
             // (in half-edits) as well as to the action's bound.
             let min_len = p.min_len();
-            let longest = n.saturating_sub(1);
             let reach = usize::from(d) + usize::from(p.cyclic());
             let Some((j, cost, _)) = best_start(
                 &p,
                 reach.min(top_level(&p)).min(255) as u8,
                 back,
                 |j, v| edits_fit(v, (j + 1).max(min_len)).then(|| Candidate::merit_of(j + 1, v)),
-                |best| Candidate::max_cost_beating(best, longest + 1),
+                |best| Candidate::max_cost_beating(best, n),
             ) else {
                 continue;
             };

@@ -111,7 +111,9 @@ impl Candidate {
     /// The highest cost at which a match of at most `max_len` tokens can still have a merit
     /// above `merit` (0 when none can).
     pub fn max_cost_beating(merit: i32, max_len: usize) -> u8 {
-        let top = Self::merit_of(max_len, 0) - merit - 1;
+        let top = Self::merit_of(max_len, 0)
+            .saturating_sub(merit)
+            .saturating_sub(1);
         (top.max(0) / 3).min(255) as u8
     }
 
@@ -351,5 +353,16 @@ mod tests {
         };
         assert!(crouch.merit() > jump.merit());
         assert!(crouch.beats(&jump) && !jump.beats(&crouch));
+    }
+
+    #[test]
+    fn the_cost_that_can_still_beat_a_merit() {
+        // 5 tokens (merit 20 when exact) beat merit 14 up to cost 1 (20 − 3 = 17 > 14) and
+        // 2 (14 is not above 14): 1.
+        assert_eq!(Candidate::max_cost_beating(14, 5), 1);
+        assert_eq!(Candidate::max_cost_beating(20, 5), 0);
+        // Any merit at all: capped, no overflow.
+        assert_eq!(Candidate::max_cost_beating(i32::MIN, 5), 255);
+        assert_eq!(Candidate::max_cost_beating(i32::MAX, 5), 0);
     }
 }

@@ -209,19 +209,20 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
     let ex = all_examples(lib)?;
     let mut steps = Vec::new();
     let mut stuck = vec![false; lib.actions.len()];
+    // Each action's overlap with the others' examples: only a narrowed action's changes.
+    let mut overlaps: Vec<Overlap> = lib
+        .actions
+        .iter()
+        .enumerate()
+        .map(|(i, a)| overlap(a, i, &ex))
+        .collect::<Result<_>>()?;
     while steps.len() < MAX_STEPS {
-        // The action that accepts the most foreign examples exactly.
-        let mut worst: Option<(usize, Overlap)> = None;
-        for (i, a) in lib.actions.iter().enumerate() {
-            if stuck[i] {
-                continue;
-            }
-            let o = overlap(a, i, &ex)?;
-            if o.exact > 0 && worst.as_ref().is_none_or(|(_, w)| o.exact > w.exact) {
-                worst = Some((i, o));
-            }
-        }
-        let Some((i, before)) = worst else { break };
+        // The action that accepts the most foreign examples exactly (the first on a tie).
+        let worst = (0..lib.actions.len())
+            .filter(|&i| !stuck[i] && overlaps[i].exact > 0)
+            .min_by_key(|&i| (std::cmp::Reverse(overlaps[i].exact), i));
+        let Some(i) = worst else { break };
+        let before = &overlaps[i];
         let entry = &lib.actions[i];
         let own_costs: Vec<Option<u8>> = ex
             .iter()
@@ -263,6 +264,7 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
                     no_longer,
                 });
                 lib.actions[i] = cand;
+                overlaps[i] = after;
             }
             _ => stuck[i] = true,
         }
