@@ -1,7 +1,7 @@
 //! Stage 8 — Laban effort: one two-class classifier per axis (seed 000 §5.4).
 //!
 //! Time (positive class *sudden*) and Weight (positive class *strong*), each over its own
-//! subset of the 54 segment features, chosen on the host by the inter/intra-class variance
+//! subset of the 58 segment features, chosen on the host by the inter/intra-class variance
 //! ratio and cross-validation. Each axis is one of two [`Classifier`]s, whichever
 //! cross-validated better when it was trained:
 //! - Gaussian naive Bayes (the seed's): `L = tanh(Λ / (2·m))`, where Λ is the log posterior
@@ -16,11 +16,11 @@
 //!
 //! # Effort blob layout, version [`EFFORT_VERSION`] (little-endian)
 //! ```text
-//! 0   4   magic "FGE" + version byte (2)
+//! 0   4   magic "FGE" + version byte (3)
 //! then two axes (Time, Weight), each:
 //! +0  1   classifier: 0 = naive Bayes, 1 = linear discriminant
 //! +1  1   m: number of features (1 ≤ m ≤ MAX_EFFORT_FEATURES)
-//! +2  m   feature indices (< 54, distinct)
+//! +2  m   feature indices (< 58, distinct)
 //! +..  4  naive Bayes: prior log-odds of the positive class; linear: the bias b (f32)
 //! +..     naive Bayes: 16m, per feature mean⁺, variance⁺, mean⁻, variance⁻ (f32, variances
 //!         > 0); linear: 4m, per feature its weight wₖ (f32)
@@ -33,7 +33,7 @@ use crate::Error;
 /// Maximum features per axis.
 pub const MAX_EFFORT_FEATURES: usize = 16;
 /// Effort blob format version.
-pub const EFFORT_VERSION: u8 = 2;
+pub const EFFORT_VERSION: u8 = 3;
 /// Largest valid effort blob, bytes (560: two naive Bayes axes of 16 features).
 pub const MAX_EFFORT_BYTES: usize =
     4 + 2 * (2 + MAX_EFFORT_FEATURES + 4 + 16 * MAX_EFFORT_FEATURES);

@@ -8,11 +8,13 @@
 //! where speed vanishes. Two of ours split the tangential acceleration `ṙ·r̈/|ṙ|` into its
 //! speeding-up and slowing-down parts: how a stroke *starts* (an explosive or an easing onset:
 //! Time) and how it *stops* (an impact or a fade: Weight) are what Laban observers look at,
-//! and the seed's unsigned magnitudes mix the two.
+//! and the seed's unsigned magnitudes mix the two. Two more split the angular acceleration
+//! along the spin, `ω·ω̇/|ω|`, the same way: a bow, a turn or a wave is a twist, whose impact
+//! or fade no translation quantity sees.
 //!
 //! [`Accum`] keeps count, Σx and Σx² per quantity (one per token run: any segment's statistics
 //! are the sum of its runs' accumulators). [`segment_features`] turns an accumulator into the
-//! 54 features — the mean of each quantity, then its *relative* spread (standard deviation
+//! 58 features — the mean of each quantity, then its *relative* spread (standard deviation
 //! over mean, the coefficient of variation) — in the log domain `ln(FEATURE_EPS + x)`, where
 //! Gaussian naive Bayes fits much better than on the raw, heavy-tailed values. Means carry the
 //! tempo (they are rates per second once divided by the mean speed); the relative spread is
@@ -26,7 +28,7 @@ use crate::frame::Kinematics;
 use crate::intake::TICK_S;
 
 /// Per-tick quantities.
-pub const QUANTITIES: usize = 27;
+pub const QUANTITIES: usize = 29;
 /// Segment features: mean and relative spread of each quantity.
 pub const FEATURES: usize = 2 * QUANTITIES;
 /// Bound on |curvature| (1/m) and |torsion| (1/m).
@@ -67,9 +69,11 @@ pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
     "equiaffine.acc",
     "world.speedup",
     "world.slowdown",
+    "ang.speedup",
+    "ang.slowdown",
 ];
 
-/// Sums over a set of ticks. 220 bytes.
+/// Sums over a set of ticks. 236 bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accum {
     /// Number of ticks.
@@ -127,7 +131,7 @@ impl Accum {
 /// the features do not change when the same gesture is made larger or smaller. The mean world
 /// speed itself (feature 18) stays absolute: the one feature that knows the size.
 const SCALE_KIND: [u8; QUANTITIES] = [
-    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3, 1, 1,
+    1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0, 1, 1, 1, 2, 2, 3, 3, 1, 1, 0, 0,
 ];
 
 /// The log-domain, scale-free features of a segment: means (each divided or multiplied by its
@@ -224,6 +228,15 @@ impl FeatureExtractor {
         };
         q[25] = fmath::max(tangential, 0.0);
         q[26] = fmath::max(-tangential, 0.0);
+        // The same split for the twist: how a turn or a bow starts and stops.
+        let spin = fmath::norm3(k.w);
+        let angular = if spin > 1e-3 {
+            fmath::dot3(k.w, k.wa) / spin
+        } else {
+            0.0
+        };
+        q[27] = fmath::max(angular, 0.0);
+        q[28] = fmath::max(-angular, 0.0);
         for x in &mut q {
             if !fmath::is_finite(*x) {
                 *x = 0.0;
@@ -291,6 +304,25 @@ mod tests {
         // At rest there is no path to be along.
         let q = fx.quantities(&kin([0.0; 3], [5.0, 0.0, 0.0], [0.0; 3]));
         assert!(q[25] == 0.0 && q[26] == 0.0);
+    }
+
+    #[test]
+    fn angular_acceleration_splits_along_the_spin() {
+        let mut fx = FeatureExtractor::new();
+        let mut k = kin([0.0; 3], [0.0; 3], [0.0; 3]);
+        // Spinning at 2 rad/s about the object's y axis, slowing by 5 rad/s² while also
+        // tilting the spin axis (3 rad/s² about x, which neither starts nor stops the spin).
+        k.w = [0.0, 2.0, 0.0];
+        k.wa = [3.0, -5.0, 0.0];
+        let q = fx.quantities(&k);
+        assert!(q[27] == 0.0 && (q[28] - 5.0).abs() < 1e-5, "{q:?}");
+        k.w = [0.0, -2.0, 0.0];
+        let q = fx.quantities(&k);
+        assert!((q[27] - 5.0).abs() < 1e-5 && q[28] == 0.0, "{q:?}");
+        // No spin, no axis to be along; linear quantities are untouched by the twist.
+        k.w = [0.0; 3];
+        let q = fx.quantities(&k);
+        assert!(q[27] == 0.0 && q[28] == 0.0 && q[25] == 0.0 && q[26] == 0.0);
     }
 
     #[test]

@@ -12,7 +12,7 @@
 //! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
 //! tokens cost half) → [`segment`] (online decision; stand-alone gestures no action matched
 //! given to their [`nearest`] action) →
-//! [`features`] (54 Laban features: the seed's 50, redefined, plus 4) → [`bayes`] (Time and
+//! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
 //!
@@ -22,7 +22,7 @@
 //! | [`pattern::MAX_ACTIONS`] | 32 actions | 64 B of record offsets (patterns stay in flash) |
 //! | [`pattern::MAX_POSITIONS`] | 32 tokens per pattern | blob ≤ [`pattern::MAX_LIBRARY_BYTES`] (flash) |
 //! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 7 × 8 B = 1.75 KiB of automaton state (half-edit levels) |
-//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 9.7 KiB (features per run) |
+//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 10.6 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`token::SWEEP_TICKS`] | 8 ticks of a quick stroke after stillness | 16 B |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |

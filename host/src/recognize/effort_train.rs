@@ -1,7 +1,7 @@
 //! `figurine train-effort`: Laban Time/Weight classifiers from labelled one-gesture logs.
 //!
 //! DIR holds `sudden-strong/`, `sudden-light/`, `sustained-strong/`, `sustained-light/` with
-//! one-gesture pose logs. Each log's 54 features are computed by the device front end over the
+//! one-gesture pose logs. Each log's 58 features are computed by the device front end over the
 //! gesture (first to last motion). Per axis, features are ranked by σ²inter / σ²intra
 //! (seed 000 §5.3, eqs. 2–5); the number M of top features is chosen by stratified k-fold
 //! cross-validated accuracy (ranking redone inside each fold, so the estimate is honest), for
@@ -53,7 +53,7 @@ pub struct TrainEffortArgs {
 /// One labelled example: features and (sudden?, strong?).
 #[derive(Debug, Clone)]
 pub struct Example {
-    /// The 54 log-domain features.
+    /// The 58 log-domain features.
     pub f: [f32; FEATURES],
     /// Sudden (true) or sustained.
     pub sudden: bool,
