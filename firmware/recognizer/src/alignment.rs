@@ -133,9 +133,25 @@ pub(crate) fn advance(p: &Pattern<'_>, d: &mut [u64], c: Token, anywhere: bool) 
 /// Weighted edit distance (half-edits) between `tokens` (oldest first) and the whole of
 /// pattern `p`: the cheapest way to read all the tokens from the initial state to an
 /// accepting one. None when it exceeds `bound` (itself capped at [`MAX_COST`]).
-// Once per stand-alone phrase and action: out of line, one copy (flash).
-#[inline(never)]
 pub fn weighted_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8> {
+    read_from_start(p, tokens, bound, false)
+}
+
+/// Lowest cost (half-edits, ≤ `bound`) at which `tokens` (oldest first) are the beginning of
+/// a match of `p` that has not ended: some position other than the accepting ones is reached
+/// after reading them all (the tolerant counterpart of
+/// [`crate::automaton::prefix_alive`]). None when no such alignment is within the bound.
+pub fn prefix_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8> {
+    read_from_start(p, tokens, bound, true)
+}
+
+/// Reads `tokens` into levels that began at the pattern's start; returns the lowest level
+/// that accepts, or with `unfinished` the lowest that reaches a position other than the
+/// initial and the accepting ones.
+// Once per stand-alone phrase or pause and action: out of line, one copy of `advance` for
+// both uses (flash).
+#[inline(never)]
+fn read_from_start(p: &Pattern<'_>, tokens: &[Token], bound: u8, unfinished: bool) -> Option<u8> {
     let mut all = [0u64; LEVELS];
     let d = all
         .get_mut(..=usize::from(bound.min(MAX_COST)))
@@ -156,7 +172,14 @@ pub fn weighted_cost(p: &Pattern<'_>, tokens: &[Token], bound: u8) -> Option<u8>
             return None;
         }
     }
-    best
+    if unfinished {
+        // Bit 0 is the initial state: every token inserted is no beginning.
+        d.iter()
+            .position(|&x| x & !1 & !p.last() != 0)
+            .map(|v| v as u8)
+    } else {
+        best
+    }
 }
 
 #[cfg(test)]
@@ -263,6 +286,23 @@ mod tests {
         let crouch = cost(&["d", "u"], "d.Xp u.Xn u").unwrap();
         let jump = cost(&["d", "u", "d"], "d.Xp u.Xn u").unwrap();
         assert!(crouch < jump, "crouch {crouch} jump {jump}");
+    }
+
+    #[test]
+    fn a_prefix_costs_what_reading_it_into_an_unfinished_match_costs() {
+        let blob = seq_library(&[(&["d", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let p = lib.pattern(0).unwrap();
+        let pre = |t: &str| prefix_cost(&p, &toks(t), 3 * FULL);
+        // A crouch gone down, with a 45° wobble on the way: under way at half an edit.
+        assert_eq!(pre("d d"), Some(0));
+        assert_eq!(pre("d df d"), Some(HALF));
+        // Down and up is a whole crouch: only an extra stroke keeps it unfinished.
+        assert_eq!(pre("d u"), Some(FULL));
+        // Nothing read is under way only past a stroke left out.
+        assert_eq!(pre(""), Some(FULL));
+        // Nothing like it within the bound.
+        assert_eq!(pre("f f f b"), None);
     }
 
     #[test]

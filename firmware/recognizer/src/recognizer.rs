@@ -7,6 +7,7 @@
 //! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
 //! all (15,152 B by `size_of`, measured by a test) with 32 actions loaded.
 
+use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::features::{segment_features, Accum};
@@ -263,7 +264,8 @@ impl<'lib> Recognizer<'lib> {
     /// Whether another action's match began with `p` (its own first part skipped) or, exactly,
     /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
     /// under way: then a pause after `p` is a hold inside that longer gesture — a punch held at
-    /// full reach after its forward stroke.
+    /// full reach after its forward stroke. When `p` needed a whole edit, a match under way
+    /// that is not exact but costs less than `p` ([`prefix_cost`]) counts too.
     // Once per pause at most: kept out of the per-sample path (flash, not speed).
     #[cold]
     #[inline(never)]
@@ -294,6 +296,10 @@ impl<'lib> Recognizer<'lib> {
         }
         let Some(ps) = at_start else { return false };
         let moving = tok.get(..n).unwrap_or(&[]);
+        // When `p` itself needed a whole edit, another action that explains the same tokens
+        // more cheaply and is not finished is as good a reason to wait: a crouch held low
+        // after going down with a wobble, where a jump without its hop matched the descent.
+        let tolerance = if p.cost >= FULL { p.cost - 1 } else { 0 };
         let alive_from = |from: usize, skip_first: bool| {
             let tokens = moving.get(from..).unwrap_or(&[]);
             (0..self.library.len()).any(|a| {
@@ -301,12 +307,17 @@ impl<'lib> Recognizer<'lib> {
                     && self.library.pattern(a).is_some_and(|pat| {
                         // Its match so far covers all of `p` and needs more: a longer one.
                         prefix_alive(&pat, tokens, skip_first)
+                            || (!skip_first
+                                && tolerance > 0
+                                && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
+                                    .is_some())
                     })
             })
         };
         // Begun with the pending candidate, but without its own first part, or exactly a
-        // little earlier.
+        // little earlier; or, tolerantly, with it.
         alive_from(ps, true)
+            || (tolerance > 0 && alive_from(ps, false))
             || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
@@ -828,6 +839,45 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    /// Going down (0.4 s, pitching 0.24 rad in its first half), held low for `hold_s`, back
+    /// up (0.4 s), at 120 Hz.
+    fn crouch_held_low(hold_s: f32) -> Vec<Sample> {
+        let rate = 120.0f32;
+        let (still, stroke) = (0.6f32, 0.4f32);
+        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
+        let total = 2.0 * still + 2.0 * stroke + hold_s;
+        (0..(total * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let down = ramp((t - still) / stroke);
+                let up = ramp((t - still - stroke - hold_s) / stroke);
+                let half = 0.12 * ramp((t - still) / (0.5 * stroke));
+                Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, 1.0 - 0.15 * (down - up), 0.0],
+                    quat: [libm::cosf(half), libm::sinf(half), 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_match_that_left_a_stroke_out_waits_for_a_closer_action_under_way() {
+        // "jump" explains the pitched descent by leaving its hop out (a whole edit); "crouch"
+        // explains it at half an edit (the pitch) and is not finished: the hold is part of it.
+        let blob = seq_library(&[(&["d.Xp", "u", "d"], 1), (&["d", "u"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &crouch_held_low(0.8));
+        let got: Vec<_> = ev.iter().map(|e| (e.action, e.revises)).collect();
+        assert_eq!(got.last(), Some(&(1, true)), "{ev:?}");
+        let crouch = ev.last().unwrap();
+        assert!(
+            crouch.start_us < 800_000 && crouch.end_us > 1_900_000,
+            "{ev:?}"
+        );
     }
 
     #[test]

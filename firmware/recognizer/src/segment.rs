@@ -14,7 +14,8 @@
 //! - the figurine has been still for [`PAUSE_US`] after it ([`CYCLIC_PAUSE_US`] for an action
 //!   whose pattern repeats as a whole; up to [`HOLD_US`] — [`INEXACT_HOLD_US`] when it
 //!   needed near substitutions, [`GAPPED_HOLD_US`] when it needed a whole edit — while another
-//!   action has matched further than it exactly and may go on after the hold), or
+//!   action has matched further than it exactly, or, for a candidate that needed a whole
+//!   edit, at a lower cost, and may go on after the hold), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
