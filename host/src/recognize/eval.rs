@@ -88,13 +88,7 @@ pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<Library
         lib.upsert(learn_action(action.name(), &logs, None, true)?);
     }
     for step in super::separate::separate(&mut lib)? {
-        eprintln!(
-            "  narrowed `{}`: {}  ->  {}  (no longer accepts exactly {})",
-            step.action,
-            step.from,
-            step.to,
-            step.no_longer.join(", ")
-        );
+        eprintln!("  {step}");
     }
     Ok(lib)
 }

@@ -19,8 +19,9 @@
 //! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
 //!    three tokens of the shortest match.
 //! 7. Against the rest of the library ([`super::separate`]): a pattern that accepts another
-//!    action's example exactly is narrowed until it does not (or cannot be without losing its
-//!    own examples).
+//!    action's example exactly is narrowed until it does not; when it cannot be without
+//!    losing its own examples, the other action is made as tolerant of the shared strokes'
+//!    rotations.
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -812,12 +813,7 @@ pub fn run(args: &LearnArgs) -> Result<()> {
     );
     lib.upsert(entry);
     for step in super::separate::separate(&mut lib)? {
-        eprintln!(
-            "narrowed `{}` to `{}`: it accepted {} exactly",
-            step.action,
-            step.to,
-            step.no_longer.join(", ")
-        );
+        eprintln!("{step}");
     }
     lib.write(&args.library)?;
     Ok(())

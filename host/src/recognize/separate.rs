@@ -21,6 +21,18 @@
 //! Optional groups are not made mandatory: that can make a pattern win ties it should not
 //! (`d+ u+ (u~)*` → `d+ u+ (u~)+` is a longer shortest match, so it outranks a crouch's
 //! `d+ u+` on a crouch that rises in two strokes).
+//!
+//! What narrowing cannot separate is evened out instead. A jump whose examples all pitched
+//! (`(d.Xn|d|d.Xp)+ (u.Xn|u|u.Xp)+ …`) and whose landing some example lacked accepts a
+//! crouch's plain `d u` exactly, and narrowing it would lose its own examples; a crouch
+//! performed with the same small pitch would then cost the crouch two half edits and the
+//! jump none. So the action whose examples another pattern still accepts exactly is widened:
+//! each plain stroke of its pattern that the other allows rotated is allowed the same
+//! rotations (`d+ u+` → `(d.Xn|d|d.Xp)+ (u.Xn|u|u.Xp)+`). Exact ties then go to the more
+//! specific pattern, as the recognizer's tie-break has it. A widening that would make the
+//! pattern accept more foreign examples exactly is not taken.
+
+use std::collections::{BTreeMap, BTreeSet};
 
 use anyhow::Result;
 use figurine_recognizer::token::{Symbol, ANY_LIN, ANY_ROT, NONE_BIN};
@@ -32,17 +44,52 @@ use super::regex::Regex;
 /// Narrowing steps [`separate`] takes at most over a whole library.
 pub const MAX_STEPS: usize = 32;
 
-/// One narrowing step taken: which action, and its pattern before and after.
+/// One step taken: which action, its pattern before and after, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Narrowed {
-    /// The narrowed action.
+pub struct Step {
+    /// The changed action.
     pub action: String,
     /// Its pattern before.
     pub from: String,
     /// Its pattern after.
     pub to: String,
-    /// Examples of other actions it accepted exactly before, as `action: tokens`.
-    pub no_longer: Vec<String>,
+    /// Narrowed or widened, and why.
+    pub kind: StepKind,
+}
+
+/// Why a pattern changed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StepKind {
+    /// It accepted these examples of other actions exactly (`action: tokens`), and no longer
+    /// does.
+    Narrowed(Vec<String>),
+    /// Action `.0` still accepts these examples of it exactly: it now allows the rotations of
+    /// the shared strokes that action allows.
+    Widened(String, Vec<String>),
+}
+
+impl std::fmt::Display for Step {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.kind {
+            StepKind::Narrowed(no_longer) => write!(
+                f,
+                "narrowed `{}`: {}  ->  {}  (it accepted {} exactly)",
+                self.action,
+                self.from,
+                self.to,
+                no_longer.join(", ")
+            ),
+            StepKind::Widened(like, examples) => write!(
+                f,
+                "widened `{}`: {}  ->  {}  (as tolerant of rotations as `{like}`, which accepts \
+                 its {} exactly)",
+                self.action,
+                self.from,
+                self.to,
+                examples.join(", ")
+            ),
+        }
+    }
 }
 
 /// Whether `s` is a plain stroke (translation, no rotation, no wildcard).
@@ -204,8 +251,9 @@ fn keeps_own(cand: &ActionEntry, own: usize, ex: &Examples, before: &[Option<u8>
 }
 
 /// Narrows the patterns of `lib` until none accepts another action's example exactly, or no
-/// step helps (see the module docs). Returns the steps taken, in order.
-pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
+/// step helps, then widens the actions whose examples are still accepted by another (see the
+/// module docs). Returns the steps taken, in order.
+pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Step>> {
     let ex = all_examples(lib)?;
     let mut steps = Vec::new();
     let mut stuck = vec![false; lib.actions.len()];
@@ -257,11 +305,11 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
                     .filter(|w| !after.which.contains(w))
                     .map(|(a, src)| format!("{}: {src}", lib.actions[*a].name))
                     .collect();
-                steps.push(Narrowed {
+                steps.push(Step {
                     action: cand.name.clone(),
                     from: lib.actions[i].regex.clone(),
                     to: cand.regex.clone(),
-                    no_longer,
+                    kind: StepKind::Narrowed(no_longer),
                 });
                 lib.actions[i] = cand;
                 overlaps[i] = after;
@@ -269,7 +317,123 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Narrowed>> {
             _ => stuck[i] = true,
         }
     }
+    // What narrowing could not separate: the action whose examples another pattern still
+    // accepts exactly is made as tolerant of the shared strokes' rotations as that pattern
+    // (until nothing changes: a widened pattern may now accept the other's examples).
+    let mut changed = true;
+    while changed && steps.len() < MAX_STEPS {
+        changed = false;
+        for i in 0..lib.actions.len() {
+            let victims: BTreeSet<usize> = overlaps[i].which.iter().map(|(a, _)| *a).collect();
+            if victims.is_empty() {
+                continue;
+            }
+            let mut variants = BTreeMap::new();
+            rotations(&Regex::parse(&lib.actions[i].regex)?, &mut variants);
+            for b in victims {
+                let entry = &lib.actions[b];
+                let re = widen(&Regex::parse(&entry.regex)?, &variants);
+                let Ok(cand) = ActionEntry::new(
+                    &entry.name,
+                    &re.to_source(),
+                    Some(entry.max_edits),
+                    entry.examples.clone(),
+                ) else {
+                    continue;
+                };
+                if cand.regex == entry.regex {
+                    continue;
+                }
+                let after = overlap(&cand, b, &ex)?;
+                if after.exact > overlaps[b].exact {
+                    continue;
+                }
+                let shared = overlaps[i]
+                    .which
+                    .iter()
+                    .filter(|(a, _)| *a == b)
+                    .map(|(_, src)| src.clone())
+                    .collect();
+                steps.push(Step {
+                    action: cand.name.clone(),
+                    from: entry.regex.clone(),
+                    to: cand.regex.clone(),
+                    kind: StepKind::Widened(lib.actions[i].name.clone(), shared),
+                });
+                lib.actions[b] = cand;
+                overlaps[b] = after;
+                changed = true;
+            }
+        }
+    }
     Ok(steps)
+}
+
+/// The rotated variants `re` allows each plain stroke in its sites: plain symbol → variants.
+fn rotations(re: &Regex, out: &mut BTreeMap<Symbol, BTreeSet<Symbol>>) {
+    match re {
+        Regex::Sym(_) => {}
+        Regex::Alt(v) => {
+            if let Some(Regex::Sym(p)) = plain_with_rotated(v).and_then(|k| v.get(k)) {
+                let set = out.entry(*p).or_default();
+                for r in v {
+                    if let Regex::Sym(s) = r {
+                        if rotated_of(*s, p / 27) {
+                            set.insert(*s);
+                        }
+                    }
+                }
+            }
+            v.iter().for_each(|r| rotations(r, out));
+        }
+        Regex::Cat(v) => v.iter().for_each(|r| rotations(r, out)),
+        Regex::Star(r) | Regex::Plus(r) | Regex::Opt(r) => rotations(r, out),
+    }
+}
+
+/// `re` with every plain stroke that `variants` lists accepting those rotated variants too.
+fn widen(re: &Regex, variants: &BTreeMap<Symbol, BTreeSet<Symbol>>) -> Regex {
+    let with = |p: Symbol, have: &[Regex]| -> Vec<Regex> {
+        let mut all: BTreeSet<Symbol> = variants.get(&p).cloned().unwrap_or_default();
+        all.insert(p);
+        all.into_iter()
+            .filter(|s| !have.contains(&Regex::Sym(*s)))
+            .map(Regex::Sym)
+            .collect()
+    };
+    match re {
+        Regex::Sym(p) if plain(*p) && variants.contains_key(p) => {
+            let mut v = with(*p, &[]);
+            v.sort_by_key(|r| match r {
+                Regex::Sym(s) => *s,
+                _ => 0,
+            });
+            Regex::Alt(v)
+        }
+        Regex::Sym(s) => Regex::Sym(*s),
+        Regex::Alt(v) => {
+            let mut out: Vec<Regex> = v
+                .iter()
+                .map(|r| match r {
+                    Regex::Sym(s) => Regex::Sym(*s),
+                    other => widen(other, variants),
+                })
+                .collect();
+            for r in v {
+                if let Regex::Sym(p) = r {
+                    if plain(*p) && variants.contains_key(p) {
+                        let extra = with(*p, &out);
+                        out.extend(extra);
+                    }
+                }
+            }
+            Regex::Alt(out)
+        }
+        Regex::Cat(v) => Regex::Cat(v.iter().map(|r| widen(r, variants)).collect()),
+        Regex::Star(r) => Regex::Star(Box::new(widen(r, variants))),
+        Regex::Plus(r) => Regex::Plus(Box::new(widen(r, variants))),
+        Regex::Opt(r) => Regex::Opt(Box::new(widen(r, variants))),
+    }
 }
 
 #[cfg(test)]
@@ -322,7 +486,10 @@ mod tests {
         let steps = separate(&mut lib).unwrap();
         assert_eq!(steps.len(), 1, "{steps:?}");
         assert_eq!(steps[0].action, "kick");
-        assert_eq!(steps[0].no_longer, ["punch: b f b"]);
+        assert_eq!(
+            steps[0].kind,
+            StepKind::Narrowed(vec!["punch: b f b".to_string()])
+        );
         let kick = &lib.actions[1];
         assert_eq!(kick.regex, "b* (f.Xn|f.Xp)+ (b.Xn|b|b.Xp)+ db*");
         // Its own examples still match exactly; the punch's now needs half an edit.
@@ -341,12 +508,42 @@ mod tests {
     }
 
     #[test]
-    fn a_pattern_is_left_alone_when_narrowing_would_lose_its_own_examples() {
+    fn a_pattern_that_cannot_be_narrowed_makes_the_other_as_tolerant() {
         let mut lib = LibraryFile::default();
         lib.upsert(entry("crouch", "d+ u+", 1, &["d u"]));
         lib.upsert(entry("jump", "(d|d.Xp)+ u+ d*", 1, &["d u d", "d u"]));
         let before = lib.actions[1].regex.clone();
-        assert!(separate(&mut lib).unwrap().is_empty());
-        assert_eq!(lib.actions[1].regex, before);
+        let steps = separate(&mut lib).unwrap();
+        // Narrowing the jump would lose its own `d u`: its hop stays as it was …
+        assert!(lib.actions[1].regex.starts_with("(d|d.Xp)+ u+"), "{before}");
+        // … and the crouch, whose `d u` it accepts, takes its pitch too.
+        assert_eq!(
+            steps[0].kind,
+            StepKind::Widened("jump".to_string(), vec!["d u".to_string()])
+        );
+        let crouch = &lib.actions[0];
+        assert_eq!(crouch.regex, "(d|d.Xp)+ u+");
+        // Which now accepts the jump's `d u`: the jump's landing takes the pitch as well.
+        assert_eq!(steps.len(), 2, "{steps:?}");
+        assert_eq!(lib.actions[1].regex, "(d|d.Xp)+ u+ (d|d.Xp)*");
+        // A pitched crouch is now exact for both: the tie goes to the simpler pattern.
+        let pitched = parse_tokens("d.Xp u").unwrap();
+        assert_eq!(full_match(crouch, &pitched).unwrap(), Some(0));
+        let again = separate(&mut lib).unwrap();
+        assert!(again.is_empty(), "{again:?}");
+    }
+
+    #[test]
+    fn widening_adds_the_missing_rotations_only_where_the_stroke_is() {
+        let mut variants = BTreeMap::new();
+        rotations(
+            &Regex::parse("(f.Xn|f|f.Xp)+ (b|b.Zn)+ d*").unwrap(),
+            &mut variants,
+        );
+        let re = Regex::parse("b* (f|f.Xp)+ u+ f").unwrap();
+        assert_eq!(
+            widen(&re, &variants).to_source(),
+            "(b.Zn|b)* (f|f.Xp|f.Xn)+ u+ (f.Xn|f|f.Xp)"
+        );
     }
 }
