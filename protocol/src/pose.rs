@@ -142,7 +142,9 @@ impl Pose {
             *s = u as f32 * step;
         }
         let sum = small[0] * small[0] + small[1] * small[1] + small[2] * small[2];
-        let big = libm::sqrtf((1.0 - sum).max(0.0));
+        // Correctly rounded everywhere: the FPU's instruction on the MCU, the same bits as
+        // the host's.
+        let big = figurine_fpu::sqrt((1.0 - sum).max(0.0));
         let mut q = [0f32; 4];
         let mut slot = 0;
         for (i, c) in q.iter_mut().enumerate() {

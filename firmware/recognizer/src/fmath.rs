@@ -2,15 +2,17 @@
 //!
 //! Every routine calls `libm` explicitly (correctly rounded or close to it, deterministic,
 //! the same code on the host and on the Cortex-M4F), so host simulation and the MCU compute
-//! the same bits. std's float methods are never used in this crate. micromath was measured
+//! the same bits — except the square root, which is correctly rounded by IEEE 754 wherever it
+//! is computed and so comes from the FPU's instruction on the MCU ([`figurine_fpu`]). std's float methods are never used in this crate. micromath was measured
 //! and rejected for this pipeline: its `sqrt(2.0)` returned 1.5 on this machine, which would
 //! move speed-relative token thresholds by up to 6 % and shift every feature using norms;
 //! the pipeline's float budget is small enough that libm's cost is acceptable.
 
-/// Square root (`libm::sqrtf`); negative or NaN input gives NaN as usual.
+/// Square root, correctly rounded: `VSQRT.F32` on the Cortex-M4F, `libm::sqrtf` on the host
+/// (the same bits); negative or NaN input gives NaN as usual.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
+    figurine_fpu::sqrt(x)
 }
 
 /// Absolute value (bit operation, exact).

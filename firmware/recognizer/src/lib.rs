@@ -3,8 +3,8 @@
 //! `no_std`, no allocator, no panics on any input, no clock: samples come in with their
 //! sequence numbers and timestamps ([`Sample`]), recognised actions go out as
 //! [`ActionEvent`]s with Laban Time and Weight efforts. The same code runs on the MCU and in
-//! host simulation, and all float math goes through [`fmath`] (libm), so both compute the
-//! same bits.
+//! host simulation, and all float math goes through [`fmath`] (libm, and the FPU's correctly
+//! rounded square root on the MCU), so both compute the same bits.
 //!
 //! Stages, one module each, in data-flow order:
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
