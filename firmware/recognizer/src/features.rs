@@ -29,6 +29,9 @@ use crate::intake::TICK_S;
 
 /// Per-tick quantities.
 pub const QUANTITIES: usize = 29;
+/// Index of the world speed (m/s) among the quantities; 0, 1, 2 are |velocity| along the
+/// object's left, up and front axes.
+pub const SPEED: usize = 18;
 /// Segment features: mean and relative spread of each quantity.
 pub const FEATURES: usize = 2 * QUANTITIES;
 /// Bound on |curvature| (1/m) and |torsion| (1/m).

@@ -124,6 +124,7 @@ pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) 
             min_len: p.min_len().min(255) as u8,
             positions: p.positions().min(255) as u8,
             cyclic: p.cyclic(),
+            shape: 0,
         };
         // Lower cost per aligned token: c.cost / aligned < b.cost / b_aligned.
         let better = best.is_none_or(|(b, b_aligned)| {

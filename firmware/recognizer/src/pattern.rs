@@ -8,7 +8,8 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (1)
+//! 0   4   magic "FGL" + version byte (2; version 1, the same without the shape table, is
+//!         still read)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
 //! 5   3   reserved, zero
 //! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
@@ -23,6 +24,10 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
+//! then (version 2) the shape table, 4 bytes per action in record order:
+//! +0  3   the action's motion shape: mean |velocity| along left, up, front (object frame)
+//!         over its examples, each as a share of the mean speed, × 255 rounded
+//! +3  1   1 = shape known (learnt from examples), 0 = unknown (the three bytes are zero)
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -37,16 +42,19 @@ pub const MAX_ACTIONS: usize = 32;
 pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
-/// Library blob format version.
-pub const LIBRARY_VERSION: u8 = 1;
+/// Library blob format version written by the host.
+pub const LIBRARY_VERSION: u8 = 2;
+/// Bytes per action in the shape table.
+pub const SHAPE_BYTES: usize = 4;
 /// Library blob header size, bytes.
 pub const LIBRARY_HEADER: usize = 8;
 /// Size of one action record with `n` positions, bytes.
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (11,656).
-pub const MAX_LIBRARY_BYTES: usize = LIBRARY_HEADER + MAX_ACTIONS * record_size(MAX_POSITIONS);
+/// Largest valid library blob, bytes (11,784).
+pub const MAX_LIBRARY_BYTES: usize =
+    LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
 fn rd_u64(b: &[u8], at: usize) -> Option<u64> {
     let s = b.get(at..at + 8)?;
@@ -182,6 +190,8 @@ pub struct Library<'a> {
     bytes: &'a [u8],
     n: usize,
     offsets: [u16; MAX_ACTIONS],
+    /// Offset of the shape table (0: none, a version 1 blob).
+    shapes: u16,
 }
 
 impl<'a> Library<'a> {
@@ -191,6 +201,7 @@ impl<'a> Library<'a> {
             bytes: &[],
             n: 0,
             offsets: [0; MAX_ACTIONS],
+            shapes: 0,
         }
     }
 
@@ -203,8 +214,9 @@ impl<'a> Library<'a> {
         if head[..3] != *b"FGL" {
             return Err(Error::BadMagic);
         }
-        if head[3] != LIBRARY_VERSION {
-            return Err(Error::Version(head[3]));
+        let version = head[3];
+        if version != 1 && version != LIBRARY_VERSION {
+            return Err(Error::Version(version));
         }
         let n = usize::from(head[4]);
         if n > MAX_ACTIONS {
@@ -227,10 +239,42 @@ impl<'a> Library<'a> {
             *slot = at as u16;
             at += record_size(np);
         }
+        let mut shapes = 0;
+        if version == LIBRARY_VERSION {
+            let table = bytes
+                .get(at..at + SHAPE_BYTES * n)
+                .ok_or(Error::Truncated)?;
+            for s in table.chunks_exact(SHAPE_BYTES) {
+                match s {
+                    [_, _, _, 1] | [0, 0, 0, 0] => {}
+                    _ => return Err(Error::Invalid("shape table")),
+                }
+            }
+            shapes = at as u16;
+            at += SHAPE_BYTES * n;
+        }
         if at != bytes.len() {
             return Err(Error::Invalid("trailing bytes"));
         }
-        Ok(Library { bytes, n, offsets })
+        Ok(Library {
+            bytes,
+            n,
+            offsets,
+            shapes,
+        })
+    }
+
+    /// The motion shape of action `i` — mean |velocity| along the object's left, up and
+    /// front axes, each as a share of the mean speed — when it was learnt with one.
+    pub fn shape(&self, i: usize) -> Option<[f32; 3]> {
+        if self.shapes == 0 || i >= self.n {
+            return None;
+        }
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i;
+        match *self.bytes.get(at..at + SHAPE_BYTES)? {
+            [l, u, f, 1] => Some([l, u, f].map(|b| f32::from(b) / 255.0)),
+            _ => None,
+        }
     }
 
     /// Number of actions.
@@ -399,6 +443,48 @@ pub(crate) mod tests {
             encode_record(&mut out, &syms, &follow, 1 << n, *k, false).unwrap();
         }
         out
+    }
+
+    /// `blob` (version 1) as version 2 with a shape table (`None`: unknown).
+    pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 3]>]) -> Vec<u8> {
+        let mut out = blob.to_vec();
+        out[3] = LIBRARY_VERSION;
+        for s in shapes {
+            match s {
+                Some([l, u, f]) => out.extend([*l, *u, *f, 1]),
+                None => out.extend([0; SHAPE_BYTES]),
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn version_2_carries_a_shape_per_action_and_version_1_still_loads() {
+        let v1 = seq_library(&[(&["u", "d"], 0), (&["f", "b"], 0)]);
+        let old = Library::from_bytes(&v1).unwrap();
+        assert_eq!((old.len(), old.shape(0)), (2, None));
+        let v2 = with_shapes(&v1, &[Some([0, 255, 51]), None]);
+        let lib = Library::from_bytes(&v2).unwrap();
+        assert_eq!(lib.shape(0), Some([0.0, 1.0, 0.2]));
+        assert_eq!(lib.shape(1), None);
+        assert_eq!(lib.shape(2), None);
+        assert_eq!(lib.pattern(1).unwrap().positions(), 2);
+        // A missing or partial table, a bad flag, stray bytes after an unknown shape.
+        assert_eq!(
+            Library::from_bytes(&v2[..v2.len() - 1]).err(),
+            Some(Error::Truncated)
+        );
+        let mut bad = v2.clone();
+        let flag = bad.len() - SHAPE_BYTES - 1;
+        bad[flag] = 2;
+        assert!(Library::from_bytes(&bad).is_err());
+        let mut bad = v2.clone();
+        let last = bad.len() - 2;
+        bad[last] = 7;
+        assert!(Library::from_bytes(&bad).is_err());
+        let mut v3 = v2.clone();
+        v3[3] = 3;
+        assert_eq!(Library::from_bytes(&v3).err(), Some(Error::Version(3)));
     }
 
     #[test]

@@ -5,22 +5,58 @@
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
 //! effort model 0.6 KiB, the last cyclic event (open to continuation), the state before a
 //! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
-//! all (15,152 B by `size_of`, measured by a test) with 32 actions loaded.
+//! all (15,168 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::features::{segment_features, Accum};
+use crate::features::{segment_features, Accum, SPEED};
+use crate::fmath;
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US, GAPPED_HOLD_US,
-    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, shape_penalty, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US,
+    GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
+
+/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); 0
+/// when the library has no shape for it.
+// Once per candidate, not per sample: one out-of-line copy (flash).
+#[inline(never)]
+fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u32) -> i16 {
+    match library.shape(a) {
+        Some(expected) => shape_penalty(expected, observed_shape(hist, start, end)),
+        None => 0,
+    }
+}
+
+/// The motion shape of runs `start..=end`: mean |velocity| along the object's left, up and
+/// front axes, each as a share of the mean speed (see [`shape_penalty`]).
+fn observed_shape(hist: &History, start: u32, end: u32) -> [f32; 3] {
+    let mut sum = [0.0f32; 3];
+    let (mut speed, mut n) = (0.0f32, 0u32);
+    let mut i = start;
+    for _ in 0..HISTORY_RUNS {
+        if let Some(r) = hist.get(i) {
+            for (s, x) in sum.iter_mut().zip(r.acc.sum.iter()) {
+                *s += x;
+            }
+            speed += r.acc.sum.get(SPEED).copied().unwrap_or(0.0);
+            n = n.saturating_add(r.acc.n);
+        }
+        if i == end {
+            break;
+        }
+        i = i.wrapping_add(1);
+    }
+    // The same floor as the features' (1 mm/s).
+    let speed = fmath::max(speed, 1e-3 * n as f32);
+    sum.map(|s| s / speed)
+}
 
 /// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
 /// ticks, and a tick opens at most one run.
@@ -445,15 +481,17 @@ impl<'lib> Recognizer<'lib> {
             ) else {
                 continue;
             };
+            let start = idx.get(j).copied().unwrap_or(end);
             let c = Candidate {
                 action: a as u8,
-                start: idx.get(j).copied().unwrap_or(end),
+                start,
                 end,
                 cost,
                 len: (j + 1) as u16,
                 min_len: p.min_len().min(255) as u8,
                 positions: p.positions().min(255) as u8,
                 cyclic: p.cyclic(),
+                shape: shape_of(&self.library, a, hist, start, end),
             };
             if best.is_none_or(|b| c.beats(&b)) {
                 best = Some(c);
@@ -648,6 +686,40 @@ mod tests {
         }
         rec.flush(|e| ev.push(e));
         ev
+    }
+
+    #[test]
+    fn the_motion_shape_tips_a_tie_between_actions_written_alike() {
+        // "skim" and "bob" are both `uf f df`; a bob rises about as much as it goes forward,
+        // a skim barely rises. Without shapes the tie goes to the lower index.
+        let v1 = seq_library(&[(&["uf", "f", "df"], 0), (&["uf", "f", "df"], 0)]);
+        let lib = Library::from_bytes(&v1).unwrap();
+        let ev = run(&lib, &hops(1, 0));
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [0],
+            "{ev:?}"
+        );
+        // Shares of speed (× 255): left, up, front.
+        let skim = Some([0, 50, 250]);
+        let bob = Some([0, 150, 200]);
+        let v2 = crate::pattern::tests::with_shapes(&v1, &[skim, bob]);
+        let lib = Library::from_bytes(&v2).unwrap();
+        let ev = run(&lib, &hops(1, 0));
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [1],
+            "{ev:?}"
+        );
+        // And the other way round when the hop is the skim's.
+        let v2 = crate::pattern::tests::with_shapes(&v1, &[bob, skim]);
+        let lib = Library::from_bytes(&v2).unwrap();
+        let ev = run(&lib, &hops(1, 0));
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [0],
+            "{ev:?}"
+        );
     }
 
     #[test]

@@ -4,9 +4,11 @@
 //! and last run, weighted cost, length in tokens): per action the longest match ending there
 //! at the lowest cost (for a cyclic action, the one of the highest merit within half an edit
 //! more). A pending candidate is replaced by an overlapping one of higher merit
-//! `4·length − 3·cost`, the cost in half-edits ([`crate::alignment`]: a token that differs
-//! from the pattern only in its rotation, or by 45° in its direction, costs half an edit) —
-//! near-ties go to the longest action, as in seed 000 §7.5, and an action that keeps
+//! `4·length − 3·cost − shape`, the cost in half-edits ([`crate::alignment`]: a token that
+//! differs from the pattern only in its rotation, or by 45° in its direction, costs half an
+//! edit), the shape up to one token when the matched motion moves unlike the action's
+//! examples did ([`shape_penalty`]) — near-ties go to the longest action, as in seed 000
+//! §7.5, and an action that keeps
 //! extending (a walk of several hops) grows instead of being cut. The pending candidate is
 //! committed when
 //! - a candidate appears that starts after it (the next action has begun),
@@ -24,6 +26,31 @@
 //! has paused after it.
 
 use crate::alignment::FULL;
+use crate::fmath;
+
+/// Quarter tokens of merit per squared share of speed by which a match's motion shape
+/// differs from its action's ([`shape_penalty`]).
+pub const SHAPE_WEIGHT: f32 = 50.0;
+/// Most merit a shape unlike the action's costs, quarter tokens (one token): the tokens
+/// decide, the shape only tips near-ties.
+pub const SHAPE_CAP: i16 = 4;
+
+/// The merit (quarter tokens) a match loses when its motion shape `observed` — mean
+/// |velocity| along the object's left, up and front axes as shares of the mean speed — is
+/// unlike its action's `expected` one: [`SHAPE_WEIGHT`] × the squared distance, at most
+/// [`SHAPE_CAP`]. Tokens only know which way each stroke went, to 45°; the shape keeps how
+/// much: a walk's hops bob, a run's strides skim, though both are written `uf f df`.
+pub fn shape_penalty(expected: [f32; 3], observed: [f32; 3]) -> i16 {
+    let mut d2 = 0.0;
+    for (e, o) in expected.iter().zip(observed.iter()) {
+        d2 += (e - o) * (e - o);
+    }
+    if !fmath::is_finite(d2) {
+        // A degenerate shape: no evidence either way.
+        return 0;
+    }
+    fmath::min(SHAPE_WEIGHT * d2, f32::from(SHAPE_CAP)) as i16
+}
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
 pub const LOOKAHEAD_TOKENS: u8 = 4;
@@ -90,6 +117,9 @@ pub struct Candidate {
     pub positions: u8,
     /// The pattern can repeat as a whole (a cyclic action: walk, wave …).
     pub cyclic: bool,
+    /// How far the matched motion's shape is from its action's ([`shape_penalty`]),
+    /// quarter tokens (0 ..= [`SHAPE_CAP`]), taken off its merit.
+    pub shape: i16,
 }
 
 impl Candidate {
@@ -99,9 +129,10 @@ impl Candidate {
     }
 
     /// Ranking score, in quarter tokens: longer is better, each edit costs 1.5 tokens
-    /// (a rotation-only disagreement half of that).
+    /// (a rotation-only disagreement half of that), a shape unlike the action's up to one
+    /// token.
     pub fn merit(&self) -> i32 {
-        Self::merit_of(usize::from(self.len), self.cost)
+        Self::merit_of(usize::from(self.len), self.cost) - i32::from(self.shape)
     }
 
     /// [`Candidate::merit`] of a match over `len` tokens at `cost` half-edits.
@@ -242,7 +273,32 @@ mod tests {
             min_len: 1,
             positions: 1,
             cyclic: false,
+            shape: 0,
         }
+    }
+
+    #[test]
+    fn a_shape_unlike_the_actions_costs_up_to_one_token() {
+        let walk = [0.1, 0.55, 0.75];
+        assert_eq!(shape_penalty(walk, walk), 0);
+        // A run's flatter strides: 0.3 less up, 0.1 more front → 50 × 0.1 = 5 → capped at 4.
+        assert_eq!(shape_penalty(walk, [0.1, 0.25, 0.85]), SHAPE_CAP);
+        // A little off: 50 × 0.04² ≈ 0.08 → nothing.
+        assert_eq!(shape_penalty(walk, [0.1, 0.51, 0.75]), 0);
+        // 50 × 0.2² = 2 quarter tokens.
+        assert_eq!(shape_penalty(walk, [0.1, 0.35, 0.75]), 2);
+        assert_eq!(shape_penalty(walk, [f32::NAN, 0.5, 0.7]), 0);
+        // Taken off the merit: an exact tie goes to the matching shape.
+        let a = Candidate {
+            shape: 0,
+            ..c(0, 1, 3, 0)
+        };
+        let b = Candidate {
+            shape: 2,
+            ..c(1, 1, 3, 0)
+        };
+        assert!(a.beats(&b) && !b.beats(&a));
+        assert_eq!(b.merit(), a.merit() - 2);
     }
 
     #[test]

@@ -30,6 +30,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
+use figurine_recognizer::features::{Accum, SPEED};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::segment::edits_fit;
 use figurine_recognizer::token::{
@@ -84,6 +85,35 @@ pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
             )
         })
         .collect()
+}
+
+/// The motion shape of a one-performance log's gesture: mean |velocity| along the figurine's
+/// left, up and front axes, each as a share of the mean speed — what the device measures over
+/// a match (`figurine_recognizer::segment::shape_penalty`). None without motion.
+pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g = gesture_runs(&runs);
+    if g.is_empty() {
+        return None;
+    }
+    let mut acc = Accum::new();
+    for r in g {
+        acc.merge(&r.acc);
+    }
+    // The device's floor of the mean speed (1 mm/s).
+    let speed = acc.sum[SPEED].max(1e-3 * acc.n as f32);
+    Some([0, 1, 2].map(|k| acc.sum[k] / speed))
+}
+
+/// The mean motion shape of the examples ([`motion_shape`]); None when none moved.
+pub fn mean_shape(logs: &[PoseLog]) -> Option<[f32; 3]> {
+    let shapes: Vec<[f32; 3]> = logs.iter().filter_map(motion_shape).collect();
+    if shapes.is_empty() {
+        return None;
+    }
+    let n = shapes.len() as f32;
+    Some([0, 1, 2].map(|k| shapes.iter().map(|s| s[k]).sum::<f32>() / n))
 }
 
 /// The span (seconds, log clock) from the first to the last motion of a one-gesture log.
@@ -739,7 +769,8 @@ pub fn learn_action(
         &re.to_source(),
         Some(max_edits.unwrap_or_else(|| default_edits(c.min_len()))),
         examples,
-    )?;
+    )?
+    .with_shape(mean_shape(logs));
     Ok(entry)
 }
 
@@ -807,8 +838,11 @@ pub fn run(args: &LearnArgs) -> Result<()> {
     for w in collisions(&lib, &entry)? {
         eprintln!("warning: {w}");
     }
+    let shape = entry.shape.map_or(String::new(), |[l, u, f]| {
+        format!(", moves left/up/front {l:.2}/{u:.2}/{f:.2} of its speed")
+    });
     println!(
-        "{}: {}  (max {} edits)",
+        "{}: {}  (max {} edits{shape})",
         entry.name, entry.regex, entry.max_edits
     );
     lib.upsert(entry);
@@ -822,7 +856,38 @@ pub fn run(args: &LearnArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::synth::{self, Action, Knobs};
     use figurine_recognizer::token::parse_token;
+
+    #[test]
+    fn a_walk_bobs_where_a_run_skims_and_a_sidestep_goes_sideways() {
+        let shape = |action: Action, seed: u64| {
+            let logs: Vec<PoseLog> = synth::examples(seed, &Knobs::default(), action, 3, None)
+                .into_iter()
+                .map(|d| d.log)
+                .collect();
+            mean_shape(&logs).unwrap()
+        };
+        for seed in [1, 2, 3] {
+            let (walk, run, side) = (
+                shape(Action::Walk, seed),
+                shape(Action::Run, seed),
+                shape(Action::Sidestep, seed),
+            );
+            // Shares of the speed, left / up / front of the figurine, whatever its heading.
+            assert!(walk[1] > run[1] + 0.15, "walk {walk:?} run {run:?}");
+            assert!(run[2] > walk[2], "walk {walk:?} run {run:?}");
+            assert!(
+                side[0] > side[2] && side[0] > walk[0] + 0.3,
+                "sidestep {side:?}"
+            );
+            for s in [walk, run, side] {
+                assert!(s.iter().all(|x| (0.0..=1.0).contains(x)), "{s:?}");
+            }
+        }
+        // No motion, no shape.
+        assert_eq!(mean_shape(&[]), None);
+    }
 
     fn seq(s: &str) -> Tokenized {
         s.split_whitespace()

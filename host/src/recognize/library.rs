@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use figurine_recognizer::pattern::{LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS};
+use figurine_recognizer::pattern::{LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES};
 use figurine_recognizer::token::{parse_token, Token, TokenName};
 use figurine_recognizer::Library;
 use serde::{Deserialize, Serialize};
@@ -36,6 +36,12 @@ pub struct ActionEntry {
     /// Token strings of the examples the pattern was learnt from.
     #[serde(default)]
     pub examples: Vec<String>,
+    /// The examples' motion shape: mean |velocity| along the figurine's left, up and front
+    /// axes, each as a share of the mean speed (averaged over the examples). The device uses
+    /// it to tip near-ties between actions (`figurine_recognizer::segment::shape_penalty`);
+    /// absent for a pattern written by hand.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<[f32; 3]>,
 }
 
 /// Human-readable compiled automaton.
@@ -116,11 +122,29 @@ impl ActionEntry {
             max_edits: 0,
             compiled: None,
             examples,
+            shape: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
         e.refresh()?;
         Ok(e)
+    }
+
+    /// The same entry with motion shape `shape` (see [`ActionEntry::shape`]).
+    pub fn with_shape(mut self, shape: Option<[f32; 3]>) -> Self {
+        self.shape = shape;
+        self
+    }
+
+    /// The device's shape-table entry: the three shares × 255 and the known flag.
+    fn shape_bytes(&self) -> [u8; SHAPE_BYTES] {
+        match self.shape {
+            Some(s) if s.iter().all(|x| x.is_finite()) => {
+                let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+                [q(s[0]), q(s[1]), q(s[2]), 1]
+            }
+            _ => [0; SHAPE_BYTES],
+        }
     }
 
     /// Recompiles the regex and fills in the readable compiled form.
@@ -198,6 +222,9 @@ impl LibraryFile {
         for a in &mut self.actions {
             out.extend(a.refresh()?);
         }
+        for a in &self.actions {
+            out.extend(a.shape_bytes());
+        }
         Library::from_bytes(&out).map_err(|e| anyhow::anyhow!("device rejects library: {e}"))?;
         self.blob_hex = to_hex(&out);
         Ok(out)
@@ -242,5 +269,28 @@ mod tests {
         );
         assert!(ActionEntry::new("x", "u d", Some(2), vec![]).is_err());
         assert!(LibraryFile::from_json("{}").is_err());
+    }
+
+    #[test]
+    fn a_learnt_shape_reaches_the_device_and_a_hand_written_pattern_has_none() {
+        let mut lib = LibraryFile::default();
+        let hop = ActionEntry::new("hop", "(uf df)+", None, vec![])
+            .unwrap()
+            .with_shape(Some([0.05, 0.6, 0.8]));
+        lib.upsert(hop);
+        lib.upsert(ActionEntry::new("slide", "l+ r+ l+", Some(1), vec![]).unwrap());
+        let blob = lib.blob().unwrap();
+        let dev = Library::from_bytes(&blob).unwrap();
+        let s = dev.shape(0).unwrap();
+        for (got, want) in s.iter().zip([0.05, 0.6, 0.8]) {
+            assert!((got - want).abs() <= 0.5 / 255.0 + 1e-6, "{s:?}");
+        }
+        assert_eq!(dev.shape(1), None);
+        // The JSON keeps it; an entry without one writes no `shape` at all.
+        let text = serde_json::to_string(&lib).unwrap();
+        assert_eq!(text.matches("\"shape\"").count(), 1, "{text}");
+        let back = LibraryFile::from_json(&text).unwrap();
+        assert_eq!(back.actions[0].shape, Some([0.05, 0.6, 0.8]));
+        assert_eq!(back.actions[1].shape, None);
     }
 }

@@ -284,7 +284,8 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Step>> {
                 &re.to_source(),
                 Some(entry.max_edits),
                 entry.examples.clone(),
-            ) else {
+            )
+            .map(|e| e.with_shape(entry.shape)) else {
                 continue;
             };
             if !keeps_own(&cand, i, &ex, &own_costs)? {
@@ -338,7 +339,8 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Step>> {
                     &re.to_source(),
                     Some(entry.max_edits),
                     entry.examples.clone(),
-                ) else {
+                )
+                .map(|e| e.with_shape(entry.shape)) else {
                     continue;
                 };
                 if cand.regex == entry.regex {
