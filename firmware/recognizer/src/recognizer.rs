@@ -4,7 +4,7 @@
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
 //! effort model 0.6 KiB, the last cyclic event (open to continuation), the state before a
-//! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.1 KiB in
+//! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.8 KiB in
 //! all (15,168 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::{prefix_cost, FULL};
@@ -22,41 +22,6 @@ use crate::segment::{
     GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
-
-/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); 0
-/// when the library has no shape for it.
-// Once per candidate, not per sample: one out-of-line copy (flash).
-#[inline(never)]
-fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u32) -> i16 {
-    match library.shape(a) {
-        Some(expected) => shape_penalty(expected, observed_shape(hist, start, end)),
-        None => 0,
-    }
-}
-
-/// The motion shape of runs `start..=end`: mean |velocity| along the object's left, up and
-/// front axes, each as a share of the mean speed (see [`shape_penalty`]).
-fn observed_shape(hist: &History, start: u32, end: u32) -> [f32; 3] {
-    let mut sum = [0.0f32; 3];
-    let (mut speed, mut n) = (0.0f32, 0u32);
-    let mut i = start;
-    for _ in 0..HISTORY_RUNS {
-        if let Some(r) = hist.get(i) {
-            for (s, x) in sum.iter_mut().zip(r.acc.sum.iter()) {
-                *s += x;
-            }
-            speed += r.acc.sum.get(SPEED).copied().unwrap_or(0.0);
-            n = n.saturating_add(r.acc.n);
-        }
-        if i == end {
-            break;
-        }
-        i = i.wrapping_add(1);
-    }
-    // The same floor as the features' (1 mm/s).
-    let speed = fmath::max(speed, 1e-3 * n as f32);
-    sum.map(|s| s / speed)
-}
 
 /// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
 /// ticks, and a tick opens at most one run.
@@ -641,6 +606,41 @@ impl<'lib> Recognizer<'lib> {
     }
 }
 
+/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); 0
+/// when the library has no shape for it.
+// Once per candidate, not per sample: one out-of-line copy (flash).
+#[inline(never)]
+fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u32) -> i16 {
+    match library.shape(a) {
+        Some(expected) => shape_penalty(expected, observed_shape(hist, start, end)),
+        None => 0,
+    }
+}
+
+/// The motion shape of runs `start..=end`: mean |velocity| along the object's left, up and
+/// front axes, each as a share of the mean speed (see [`shape_penalty`]).
+fn observed_shape(hist: &History, start: u32, end: u32) -> [f32; 3] {
+    let mut sum = [0.0f32; 3];
+    let (mut speed, mut n) = (0.0f32, 0u32);
+    let mut i = start;
+    for _ in 0..HISTORY_RUNS {
+        if let Some(r) = hist.get(i) {
+            for (s, x) in sum.iter_mut().zip(r.acc.sum.iter()) {
+                *s += x;
+            }
+            speed += r.acc.sum.get(SPEED).copied().unwrap_or(0.0);
+            n = n.saturating_add(r.acc.n);
+        }
+        if i == end {
+            break;
+        }
+        i = i.wrapping_add(1);
+    }
+    // The same floor as the features' (1 mm/s).
+    let speed = fmath::max(speed, 1e-3 * n as f32);
+    sum.map(|s| s / speed)
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -691,35 +691,20 @@ mod tests {
     #[test]
     fn the_motion_shape_tips_a_tie_between_actions_written_alike() {
         // "skim" and "bob" are both `uf f df`; a bob rises about as much as it goes forward,
-        // a skim barely rises. Without shapes the tie goes to the lower index.
+        // a skim barely rises.
         let v1 = seq_library(&[(&["uf", "f", "df"], 0), (&["uf", "f", "df"], 0)]);
-        let lib = Library::from_bytes(&v1).unwrap();
-        let ev = run(&lib, &hops(1, 0));
-        assert_eq!(
-            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
-            [0],
-            "{ev:?}"
-        );
-        // Shares of speed (× 255): left, up, front.
+        let actions = |blob: &[u8]| -> Vec<u8> {
+            let lib = Library::from_bytes(blob).unwrap();
+            run(&lib, &hops(1, 0)).iter().map(|e| e.action).collect()
+        };
+        // Without shapes the tie goes to the lower index.
+        assert_eq!(actions(&v1), [0]);
+        // Shares of speed (× 255): left, up, front. The hop is the bob's, whichever its index.
         let skim = Some([0, 50, 250]);
         let bob = Some([0, 150, 200]);
-        let v2 = crate::pattern::tests::with_shapes(&v1, &[skim, bob]);
-        let lib = Library::from_bytes(&v2).unwrap();
-        let ev = run(&lib, &hops(1, 0));
-        assert_eq!(
-            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
-            [1],
-            "{ev:?}"
-        );
-        // And the other way round when the hop is the skim's.
-        let v2 = crate::pattern::tests::with_shapes(&v1, &[bob, skim]);
-        let lib = Library::from_bytes(&v2).unwrap();
-        let ev = run(&lib, &hops(1, 0));
-        assert_eq!(
-            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
-            [0],
-            "{ev:?}"
-        );
+        let with = crate::pattern::tests::with_shapes;
+        assert_eq!(actions(&with(&v1, &[skim, bob])), [1]);
+        assert_eq!(actions(&with(&v1, &[bob, skim])), [0]);
     }
 
     #[test]

@@ -17,10 +17,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::bayes::{MAX_EFFORT_FEATURES, MIN_VARIANCE};
-use figurine_recognizer::features::{segment_features, Accum, FEATURES};
+use figurine_recognizer::features::{segment_features, FEATURES};
 
 use super::effort_model::{feature_name, AxisFile, ClassifierKind, EffortFile, FeatureParams};
-use super::feed::{gesture_runs, log_runs, log_samples};
+use super::feed::gesture_accum;
 use super::report;
 use crate::poselog::PoseLog;
 
@@ -63,17 +63,7 @@ pub struct Example {
 
 /// Features of a one-gesture log (None if it has no motion).
 pub fn gesture_features(log: &PoseLog) -> Option<[f32; FEATURES]> {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g = gesture_runs(&runs);
-    if g.is_empty() {
-        return None;
-    }
-    let mut acc = Accum::new();
-    for r in g {
-        acc.merge(&r.acc);
-    }
-    Some(segment_features(&acc))
+    gesture_accum(log).map(|acc| segment_features(&acc))
 }
 
 /// Which axis.

@@ -7,6 +7,7 @@
 //! (NaN, beyond ±100 m, zero quaternion) are dropped here and counted, as the link would.
 
 use figurine_protocol::pose::{Pose, SeqUnwrapper, TimeUnwrapper};
+use figurine_recognizer::features::Accum;
 use figurine_recognizer::frontend::{FrontEvent, Frontend};
 use figurine_recognizer::history::Run;
 use figurine_recognizer::token::STILL;
@@ -120,6 +121,22 @@ pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
     }
     // A gap clears the history, so consecutive duplicates cannot arise; keep order as seen.
     runs
+}
+
+/// Feature sums over the gesture of a one-performance log (its runs from the first to the
+/// last motion); None without motion.
+pub fn gesture_accum(log: &PoseLog) -> Option<Accum> {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g = gesture_runs(&runs);
+    if g.is_empty() {
+        return None;
+    }
+    let mut acc = Accum::new();
+    for r in g {
+        acc.merge(&r.acc);
+    }
+    Some(acc)
 }
 
 /// The runs of a one-gesture log between its first and last motion (leading and trailing

@@ -30,7 +30,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
-use figurine_recognizer::features::{Accum, SPEED};
+use figurine_recognizer::features::SPEED;
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::segment::edits_fit;
 use figurine_recognizer::token::{
@@ -40,7 +40,7 @@ use figurine_recognizer::token::{
 use figurine_recognizer::Library;
 
 use super::dtw;
-use super::feed::{gesture_runs, log_runs, log_samples};
+use super::feed::{gesture_accum, gesture_runs, log_runs, log_samples};
 use super::library::{parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
 use super::regex::{default_edits, Regex};
 use crate::poselog::PoseLog;
@@ -91,16 +91,7 @@ pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
 /// left, up and front axes, each as a share of the mean speed — what the device measures over
 /// a match (`figurine_recognizer::segment::shape_penalty`). None without motion.
 pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g = gesture_runs(&runs);
-    if g.is_empty() {
-        return None;
-    }
-    let mut acc = Accum::new();
-    for r in g {
-        acc.merge(&r.acc);
-    }
+    let acc = gesture_accum(log)?;
     // The device's floor of the mean speed (1 mm/s).
     let speed = acc.sum[SPEED].max(1e-3 * acc.n as f32);
     Some([0, 1, 2].map(|k| acc.sum[k] / speed))

@@ -186,6 +186,19 @@ fn narrowings(re: &Regex) -> Vec<Regex> {
         .collect()
 }
 
+/// `entry` with pattern `re` (same name, bound, examples and shape); None when the device
+/// could not hold it.
+fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
+    ActionEntry::new(
+        &entry.name,
+        &re.to_source(),
+        Some(entry.max_edits),
+        entry.examples.clone(),
+    )
+    .ok()
+    .map(|e| e.with_shape(entry.shape))
+}
+
 /// Every example of every action, as (action index, source text, tokens).
 type Examples = Vec<(usize, String, Vec<figurine_recognizer::token::Token>)>;
 
@@ -279,13 +292,7 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Step>> {
             .collect::<Result<_>>()?;
         let mut best: Option<(ActionEntry, Overlap)> = None;
         for re in narrowings(&Regex::parse(&entry.regex)?) {
-            let Ok(cand) = ActionEntry::new(
-                &entry.name,
-                &re.to_source(),
-                Some(entry.max_edits),
-                entry.examples.clone(),
-            )
-            .map(|e| e.with_shape(entry.shape)) else {
+            let Some(cand) = rewritten(entry, &re) else {
                 continue;
             };
             if !keeps_own(&cand, i, &ex, &own_costs)? {
@@ -334,13 +341,7 @@ pub fn separate(lib: &mut LibraryFile) -> Result<Vec<Step>> {
             for b in victims {
                 let entry = &lib.actions[b];
                 let re = widen(&Regex::parse(&entry.regex)?, &variants);
-                let Ok(cand) = ActionEntry::new(
-                    &entry.name,
-                    &re.to_source(),
-                    Some(entry.max_edits),
-                    entry.examples.clone(),
-                )
-                .map(|e| e.with_shape(entry.shape)) else {
+                let Some(cand) = rewritten(entry, &re) else {
                     continue;
                 };
                 if cand.regex == entry.regex {
