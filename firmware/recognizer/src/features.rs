@@ -32,6 +32,8 @@ pub const QUANTITIES: usize = 29;
 /// Index of the world speed (m/s) among the quantities; 0, 1, 2 are |velocity| along the
 /// object's left, up and front axes.
 pub const SPEED: usize = 18;
+/// Floor of a mean world speed (m/s) wherever one divides by it: 1 mm/s.
+pub const SPEED_FLOOR: f32 = 1e-3;
 /// Segment features: mean and relative spread of each quantity.
 pub const FEATURES: usize = 2 * QUANTITIES;
 /// Bound on |curvature| (1/m) and |torsion| (1/m).
@@ -146,14 +148,14 @@ pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
         return out;
     }
     let n = a.n as f32;
-    let speed = fmath::max(a.sum[18] / n, 1e-3);
+    let speed = fmath::max(a.sum[SPEED] / n, SPEED_FLOOR);
     let path = fmath::max(speed * n * TICK_S, 1e-3);
     for i in 0..QUANTITIES {
         let mean = a.sum[i] / n;
         let var = fmath::max(a.sum_sq[i] / n - mean * mean, 0.0);
         // The mean world speed itself stays absolute: the one feature that knows the size.
         let k = match SCALE_KIND[i] {
-            _ if i == 18 => 1.0,
+            _ if i == SPEED => 1.0,
             1 => 1.0 / speed,
             2 => path,
             3 => 1.0 / fmath::sqrt(path),
@@ -164,6 +166,26 @@ pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
             fmath::ln(FEATURE_EPS + fmath::sqrt(var) / fmath::max(mean, MEAN_FLOOR));
     }
     out
+}
+
+/// The motion shape of `n` ticks whose |velocity| along the object's left, up and front axes
+/// sums to `sums` and whose world speed sums to `speed`: each as a share of the speed
+/// (floored at [`SPEED_FLOOR`]). What an action's examples and a match are compared by
+/// (`segment::shape_penalty`).
+pub fn motion_shape(sums: [f32; 3], speed: f32, n: u32) -> [f32; 3] {
+    let speed = fmath::max(speed, SPEED_FLOOR * n as f32);
+    sums.map(|s| s / speed)
+}
+
+impl Accum {
+    /// The motion shape of these ticks ([`motion_shape`]).
+    pub fn shape(&self) -> [f32; 3] {
+        motion_shape(
+            [self.sum[0], self.sum[1], self.sum[2]],
+            self.sum[SPEED],
+            self.n,
+        )
+    }
 }
 
 /// Computes per-tick quantities; remembers the previous equi-affine velocity.
@@ -216,7 +238,7 @@ impl FeatureExtractor {
             None => 0.0,
         };
         self.prev_va = Some(eq_v);
-        q[18] = speed;
+        q[SPEED] = speed;
         q[19] = fmath::norm3(a);
         q[20] = fmath::norm3(j);
         q[21] = fmath::clamp(curvature, 0.0, GEOM_CLAMP);

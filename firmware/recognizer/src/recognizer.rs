@@ -10,8 +10,7 @@
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::features::{segment_features, Accum, SPEED};
-use crate::fmath;
+use crate::features::{motion_shape, segment_features, Accum, SPEED};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
@@ -636,9 +635,7 @@ fn observed_shape(hist: &History, start: u32, end: u32) -> [f32; 3] {
         }
         i = i.wrapping_add(1);
     }
-    // The same floor as the features' (1 mm/s).
-    let speed = fmath::max(speed, 1e-3 * n as f32);
-    sum.map(|s| s / speed)
+    motion_shape(sum, speed, n)
 }
 
 #[cfg(test)]

@@ -91,10 +91,7 @@ pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
 /// left, up and front axes, each as a share of the mean speed — what the device measures over
 /// a match (`figurine_recognizer::segment::shape_penalty`). None without motion.
 pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
-    let acc = gesture_accum(log)?;
-    // The device's floor of the mean speed (1 mm/s).
-    let speed = acc.sum[SPEED].max(1e-3 * acc.n as f32);
-    Some([0, 1, 2].map(|k| acc.sum[k] / speed))
+    gesture_accum(log).map(|acc| acc.shape())
 }
 
 /// The mean motion shape of the examples ([`motion_shape`]); None when none moved.
@@ -172,13 +169,13 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
         .copied()
         .collect();
     let dt = f64::from(figurine_recognizer::intake::TICK_S);
-    let path: f64 = g.iter().map(|r| f64::from(r.acc.sum[18]) * dt).sum();
+    let path: f64 = g.iter().map(|r| f64::from(r.acc.sum[SPEED]) * dt).sum();
     g.iter()
         .map(|r| {
             let t = r.token;
             let (lin, ang) = (t / 27, t % 27);
             let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
-            let dist = dt * f64::from(r.acc.sum[18]);
+            let dist = dt * f64::from(r.acc.sum[SPEED]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
                 (lin * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
             } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
+use figurine_recognizer::features::SPEED;
 use figurine_recognizer::token::TokenName;
 
 use super::feed::{log_runs, log_samples, Clock};
@@ -43,7 +44,7 @@ pub fn run(args: &TokensArgs) -> Result<()> {
                 clock.time_of(r.start.0),
                 clock.time_of(r.end.0),
                 TokenName(r.token).to_string(),
-                r.acc.sum[18] / n,
+                r.acc.sum[SPEED] / n,
                 (r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]) / n,
             )?;
         }
