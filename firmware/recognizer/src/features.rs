@@ -115,6 +115,9 @@ impl Accum {
     }
 
     /// Adds another accumulator.
+    // Out of line: merges happen at run joins and commits, not per tick, and each inlined
+    // copy costs flash.
+    #[inline(never)]
     pub fn merge(&mut self, o: &Accum) {
         self.n = self.n.saturating_add(o.n);
         for i in 0..QUANTITIES {

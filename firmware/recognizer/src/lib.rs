@@ -11,7 +11,8 @@
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
 //! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
 //! tokens cost half) → [`segment`] (online decision; stand-alone gestures no action matched
-//! given to their [`nearest`] action) →
+//! given to their [`nearest`] action; a match right after an event may be its next piece,
+//! its rest or its settling: [`follow`]) →
 //! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
@@ -28,12 +29,13 @@
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
 //! | [`alignment::MAX_COST`] | 23 half-edits | 192 B of stack while a candidate is weighed |
 //! | [`nearest::NEAREST_MAX_TOKENS`] | 24 tokens per stand-alone phrase | 96 B of stack |
+//! | [`history::HISTORY_RUNS`] tokens after an event | its next piece or rest, weighed whole ([`follow`]) | 80 B of stack at a commit |
 //!
 //! Latency: the filter adds 50 ms; an action is reported [`segment::PAUSE_US`] after the
 //! figurine stops, or [`segment::LOOKAHEAD_TOKENS`] tokens after it ends when actions follow
 //! each other without a pause. When it may still change — the next cycle of a cyclic action,
-//! or a longer action it is part of, may follow — it is reported then all the same, and
-//! revised if it does change ([`ActionEvent::revises`]).
+//! the rest of a one-shot one, or a longer action it is part of, may follow — it is reported
+//! then all the same, and revised if it does change ([`ActionEvent::revises`]).
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -46,6 +48,7 @@ pub mod bayes;
 pub mod features;
 pub mod filter;
 pub mod fmath;
+pub mod follow;
 pub mod frame;
 pub mod frontend;
 pub mod history;

@@ -3,22 +3,23 @@
 //! Front end (stages 0–3, 7) → automata over the library (5) → segment decision (6) → effort
 //! classification (8) at commit time. No allocation, no clock: every time comes in with the
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
-//! effort model 0.6 KiB, the last cyclic event (open to continuation), the state before a
-//! provisional report and the last stand-alone phrase's nearest action 0.6 KiB — 14.8 KiB in
-//! all (15,168 B by `size_of`, measured by a test) with 32 actions loaded.
+//! effort model 0.6 KiB, the last event (open to continuation, [`crate::follow`]), the state
+//! before a provisional report and the last stand-alone phrase's nearest action 0.6 KiB —
+//! 14.8 KiB in all (15,168 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::features::{motion_shape, segment_features, Accum, SPEED};
+use crate::features::{motion_shape, segment_features, SPEED};
+use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
 use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, shape_penalty, Candidate, Decider, Decision, CONTINUE_GAP_RUNS, CONTINUE_US,
-    GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, shape_penalty, Candidate, Decider, Decision, CONTINUE_US, GAPPED_HOLD_US,
+    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -51,11 +52,12 @@ pub struct ActionEvent {
     pub decided_seq: u32,
     /// Time of that sample, µs (decision latency = this − `end_us`).
     pub decided_us: u64,
-    /// This event revises the previous one, which a consumer replaces with it: the next
-    /// cycles of a cyclic action after a short pause extended it (same action and start, a
-    /// later end, effort and distance over all of it), or a longer action took over a
-    /// candidate that had been reported early while it might still be part of one (a run's
-    /// strides that turned out to be a punch held at full reach).
+    /// This event revises the previous one, which a consumer replaces with it: what came
+    /// after a short pause extended it — the next cycles of a cyclic action, the second piece
+    /// of a one-shot one, or its rest ([`crate::follow`]; same action and start, a later end,
+    /// effort and distance over all of it) — or a longer action took over a candidate that
+    /// had been reported early while it might still be part of one (a run's strides that
+    /// turned out to be a punch held at full reach).
     pub revises: bool,
 }
 
@@ -70,17 +72,6 @@ pub struct Stats {
     pub tokens: u32,
     /// Events emitted.
     pub events: u32,
-}
-
-/// The last emitted event of a cyclic action, while the next cycle may still continue it.
-#[derive(Debug, Clone, Copy)]
-struct Held {
-    action: u8,
-    start: (u32, u64),
-    end: (u32, u64),
-    end_run: u32,
-    distance: u8,
-    acc: Accum,
 }
 
 /// The online recognizer over a borrowed library blob (e.g. in flash).
@@ -482,38 +473,26 @@ impl<'lib> Recognizer<'lib> {
     }
 
     /// What committing `c` after the held event `held` emits — the event, and whether it
-    /// continues (revises) `held` — and the held event after it. None when `c` is too brief.
+    /// continues (revises) `held` — and the held event after it ([`crate::follow`]). None
+    /// when `c` is too brief, or is the held event's settling.
     fn outcome(&self, c: &Candidate, held: Option<Held>) -> Option<(Held, bool, Option<Held>)> {
         let ev = self.event_of(c)?;
-        match held.filter(|h| self.continues(h, c)) {
-            Some(mut h) => {
-                h.end = ev.end;
-                h.end_run = c.end;
-                h.distance = h.distance.max(c.distance());
-                h.acc.merge(&ev.acc);
-                Some((h, true, Some(h)))
+        let Some(mut h) = held else {
+            return Some((ev, false, Some(ev)));
+        };
+        match follow(&self.library, self.front.history(), &h, c) {
+            Follow::New => return Some((ev, false, Some(ev))),
+            Follow::Settles => return None,
+            Follow::Continues => h.distance = h.distance.max(c.distance()),
+            Follow::Completes(cost) => {
+                h.cost = cost;
+                h.distance = cost.div_ceil(FULL);
             }
-            None => Some((ev, false, c.cyclic.then_some(ev))),
         }
-    }
-
-    /// Whether `c` continues the cyclic event `h`: same action, nothing but stillness and a
-    /// few unmatched strokes (the edges of the cycles) between them.
-    fn continues(&self, h: &Held, c: &Candidate) -> bool {
-        if h.action != c.action {
-            return false;
-        }
-        let hist = self.front.history();
-        let mut i = h.end_run.wrapping_add(1);
-        let mut moving = 0usize;
-        for _ in 0..HISTORY_RUNS {
-            if i.wrapping_sub(h.end_run) >= c.start.wrapping_sub(h.end_run) {
-                break;
-            }
-            moving += usize::from(hist.get(i).is_none_or(|r| r.token != STILL));
-            i = i.wrapping_add(1);
-        }
-        moving <= CONTINUE_GAP_RUNS
+        h.end = ev.end;
+        h.end_run = c.end;
+        h.acc.merge(&ev.acc);
+        Some((h, true, Some(h)))
     }
 
     /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).
@@ -556,10 +535,12 @@ impl<'lib> Recognizer<'lib> {
         let acc = hist.accum(from, to);
         Some(Held {
             action: c.action,
+            start_run: c.start,
             start,
             end,
             end_run: c.end,
             distance: c.distance(),
+            cost: c.cost,
             acc,
         })
     }

@@ -60,11 +60,12 @@ pub const PAUSE_US: u64 = 120_000;
 /// pauses briefly between hops without ending. (The recognizer reports it provisionally
 /// after [`PAUSE_US`] already, so this costs no latency.)
 pub const CYCLIC_PAUSE_US: u64 = 400_000;
-/// Stillness after a cyclic action's event up to which its next cycle continues that event
-/// (instead of starting a new one), µs.
+/// Stillness after an event up to which a match may still continue it (a cyclic action's
+/// next cycle, a one-shot action's second piece or rest) or be its settling
+/// ([`crate::follow`]), µs.
 pub const CONTINUE_US: u64 = 500_000;
-/// Moving runs that may lie between a cyclic action's event and the next cycle that continues
-/// it: strokes the two matches left out at their edges (a hop's take-off before its `uf`).
+/// Moving runs that may lie between an event and a match that continues it: strokes the two
+/// matches left out at their edges (a hop's take-off before its `uf`).
 pub const CONTINUE_GAP_RUNS: usize = 2;
 /// Stillness inside a longer action that does not yet commit a shorter pending one, µs: a
 /// punch held at full reach, a crouch held low.

@@ -1,0 +1,301 @@
+//! Stage 6c — what a match right after an event is to that event: its next piece, its rest,
+//! its settling, or a new action.
+//!
+//! The last event stays *held* until [`CONTINUE_US`] of stillness have passed after it (or its
+//! runs leave the history). A match committed while it is held, with nothing but stillness
+//! and at most [`CONTINUE_GAP_RUNS`] moving runs between them, is one of:
+//!
+//! - **its next piece**: the same action, and the runs from the held event's start to the
+//!   match's end are together one whole match of it — for a cyclic action (walk, wave) any
+//!   next cycle. A turn made in two twists with a breath between is one turn; two punches are
+//!   still two punches, since `b f b b f b` is no punch. The held event is extended.
+//! - **its rest**: another action's match that completes the held action's pattern at a lower
+//!   cost than it had alone. A throw committed at the pause after its release, whose return
+//!   stroke then matched a kick, is one throw. The held event is extended.
+//! - **its settling**: another action's match with under [`SETTLE_SHARE`] of the held event's
+//!   motion. A figurine that lands from a jump and gives at the knees (`d u`, a few
+//!   millimetres) has not crouched; nothing is reported.
+//! - otherwise, a new event.
+//!
+//! Motion is measured as path length plus [`ARM_M`] × the angle turned, so that a wave or a
+//! turn (much rotation, little path) is not mistaken for a settling. Everything here runs at
+//! commits only, never per sample.
+
+use crate::alignment::{weighted_cost, FULL};
+use crate::features::{Accum, SPEED};
+use crate::history::{History, HISTORY_RUNS};
+use crate::pattern::Library;
+#[cfg(doc)]
+use crate::segment::CONTINUE_US;
+use crate::segment::{edits_fit, Candidate, CONTINUE_GAP_RUNS};
+use crate::token::{Token, ARM_M, STILL};
+
+/// Share of the held event's motion (path + [`ARM_M`] × angle) below which another action's
+/// match right after it is its settling, not an action. A jump's landing gives 2–5 cm against
+/// the jump's 30–60 cm; a crouch played after a jump at the same scale has a quarter or more.
+pub const SETTLE_SHARE: f32 = 0.2;
+
+/// The last emitted event, while a match right after it may still continue it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Held {
+    /// Action index.
+    pub action: u8,
+    /// First run of its match (absolute history index).
+    pub start_run: u32,
+    /// Input sample (seq, µs) where it starts.
+    pub start: (u32, u64),
+    /// Input sample (seq, µs) where it ends.
+    pub end: (u32, u64),
+    /// Last run of its match (absolute history index).
+    pub end_run: u32,
+    /// Edit distance reported, whole edits.
+    pub distance: u8,
+    /// Weighted cost of its match, half-edits.
+    pub cost: u8,
+    /// Feature sums over its motion phrase.
+    pub acc: Accum,
+}
+
+/// What a match is to the held event before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Follow {
+    /// Its next piece (same action).
+    Continues,
+    /// Its rest: the held action's whole match over both now costs this much (half-edits).
+    Completes(u8),
+    /// Its settling: nothing to report.
+    Settles,
+    /// A new event.
+    New,
+}
+
+/// What match `c` is to the held event `h` (see the module docs).
+// Out of line: commits only, and for flash. One pass over the runs from `h`'s start to `c`'s
+// end gathers all it needs.
+#[inline(never)]
+pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate) -> Follow {
+    let mut tok = [STILL; HISTORY_RUNS];
+    let (mut n, mut between, mut mine) = (0usize, 0usize, 0.0f32);
+    // A held event too long to read whole with what follows (a long walk) is read from its
+    // end: a next cycle still continues it, a settling is still one.
+    let mut whole = c.end.wrapping_sub(h.start_run) < HISTORY_RUNS as u32;
+    let mut i = if whole {
+        h.start_run
+    } else {
+        h.end_run.wrapping_add(1)
+    };
+    for _ in 0..HISTORY_RUNS {
+        let r = hist.get(i);
+        let moving = r.is_none_or(|r| r.token != STILL);
+        let after_h = i.wrapping_sub(h.start_run) > h.end_run.wrapping_sub(h.start_run);
+        let in_c = i.wrapping_sub(h.start_run) >= c.start.wrapping_sub(h.start_run);
+        if after_h && !in_c {
+            between += usize::from(moving);
+        }
+        match r {
+            Some(r) => {
+                if in_c {
+                    mine += motion(&r.acc);
+                }
+                if moving {
+                    match tok.get_mut(n) {
+                        Some(t) => *t = r.token,
+                        None => whole = false,
+                    }
+                    n += 1;
+                }
+            }
+            None => whole = false,
+        }
+        if i == c.end {
+            break;
+        }
+        i = i.wrapping_add(1);
+    }
+    // Only stillness and a few strokes the two matches left out at their edges (a hop's
+    // take-off before its `uf`) may lie between.
+    if between > CONTINUE_GAP_RUNS || i != c.end {
+        return Follow::New;
+    }
+    // The held action's whole match over both.
+    let cost = lib
+        .pattern(usize::from(h.action))
+        .filter(|_| whole)
+        .and_then(|p| {
+            let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
+            let tokens: &[Token] = tok.get(..n)?;
+            weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, n.max(p.min_len())))
+        });
+    if h.action == c.action {
+        return if c.cyclic || cost.is_some() {
+            Follow::Continues
+        } else {
+            Follow::New
+        };
+    }
+    match cost {
+        Some(v) if v < h.cost => Follow::Completes(v),
+        _ if mine < SETTLE_SHARE * motion(&h.acc) => Follow::Settles,
+        _ => Follow::New,
+    }
+}
+
+/// Path length plus [`ARM_M`] × angle turned, in metres per tick (only ratios are used).
+fn motion(a: &Accum) -> f32 {
+    let s = &a.sum;
+    s[SPEED] + ARM_M * (s[3] + s[4] + s[5])
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::pattern::tests::seq_library;
+    use crate::token::parse_token;
+
+    /// A history of runs, each `(token, motion)`: `motion` goes into the speed sum (STILL runs
+    /// are written `_`). Returns it with the absolute index of the first run.
+    fn history(runs: &[(&str, f32)]) -> (History, u32) {
+        let mut h = History::new();
+        let mut first = None;
+        for (k, (t, m)) in runs.iter().enumerate() {
+            let mut acc = Accum::new();
+            acc.sum[SPEED] = *m;
+            acc.n = 1;
+            let t_us = 100_000 * k as u64;
+            let i = h.open(parse_token(t).unwrap(), (k as u32, t_us), acc);
+            first.get_or_insert(i);
+        }
+        (h, first.unwrap_or(0))
+    }
+
+    fn held(hist: &History, action: u8, from: u32, to: u32, cost: u8) -> Held {
+        Held {
+            action,
+            start_run: from,
+            start: (0, 0),
+            end: (0, 0),
+            end_run: to,
+            distance: cost.div_ceil(FULL),
+            cost,
+            acc: hist.accum(from, to),
+        }
+    }
+
+    fn cand(action: u8, start: u32, end: u32, cyclic: bool) -> Candidate {
+        Candidate {
+            action,
+            start,
+            end,
+            cost: 0,
+            len: (end - start + 1) as u16,
+            min_len: 1,
+            positions: 1,
+            cyclic,
+            shape: 0,
+        }
+    }
+
+    #[test]
+    fn a_second_piece_continues_only_when_both_are_one_match() {
+        // 0 turn `.Yn+`, 1 punch `b+ f+ b+`.
+        let blob = seq_library(&[(&[".Yn"], 0), (&["b", "f", "b"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // A turn in two twists with a breath between: one turn.
+        let (hist, o) = history(&[(".Yn", 1.0), ("_", 0.0), (".Yn", 1.0)]);
+        let h = held(&hist, 0, o, o, 0);
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(0, o + 2, o + 2, false)),
+            Follow::Continues
+        );
+        // Two punches are two: `b f b b f b` is no punch.
+        let (hist, o) = history(&[
+            ("b", 1.0),
+            ("f", 1.0),
+            ("b", 1.0),
+            ("_", 0.0),
+            ("b", 1.0),
+            ("f", 1.0),
+            ("b", 1.0),
+        ]);
+        let h = held(&hist, 1, o, o + 2, 0);
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, false)),
+            Follow::New
+        );
+        // … unless the action is cyclic: its next cycle continues it.
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, true)),
+            Follow::Continues
+        );
+    }
+
+    #[test]
+    fn another_action_that_completes_the_held_one_is_its_rest() {
+        // 0 throw `ub+ f+ db+` (one edit), 1 `db+ u+`.
+        let blob = seq_library(&[(&["ub", "f", "db"], 1), (&["db", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let (hist, o) = history(&[("ub", 1.0), ("f", 1.0), ("_", 0.0), ("db", 1.0), ("u", 1.0)]);
+        // The throw was committed at the pause after its release, its `db` left out.
+        let h = held(&hist, 0, o, o + 1, FULL);
+        let rest = cand(1, o + 3, o + 4, false);
+        // `ub f db u`: one added stroke, where the throw alone had one left out: not cheaper.
+        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::New);
+        // Its return alone (`db`) completes it exactly.
+        let rest = cand(1, o + 3, o + 3, false);
+        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::Completes(0));
+        // Not when the held match was exact already.
+        let h = held(&hist, 0, o, o + 1, 0);
+        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::New);
+    }
+
+    #[test]
+    fn a_small_motion_right_after_an_event_is_its_settling() {
+        // 0 jump `d+ u+ d+`, 1 crouch `d+ u+`.
+        let blob = seq_library(&[(&["d", "u", "d"], 0), (&["d", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let jump_then = |give: f32| {
+            history(&[
+                ("d", 5.0),
+                ("u", 20.0),
+                ("d", 20.0),
+                ("_", 0.0),
+                ("d", give),
+                ("u", give),
+            ])
+        };
+        // Landing gives 2 × 2 against 45: settling.
+        let (hist, o) = jump_then(2.0);
+        let h = held(&hist, 0, o, o + 2, 0);
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false)),
+            Follow::Settles
+        );
+        // A real crouch, 2 × 6 against 45: an action.
+        let (hist, o) = jump_then(6.0);
+        let h = held(&hist, 0, o, o + 2, 0);
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false)),
+            Follow::New
+        );
+    }
+
+    #[test]
+    fn only_what_comes_right_after_counts() {
+        let blob = seq_library(&[(&["d", "u", "d"], 0), (&["d", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let with_between = |between: &[&'static str]| {
+            let mut runs = std::vec![("d", 5.0), ("u", 20.0), ("d", 20.0)];
+            runs.extend(between.iter().map(|t| (*t, 1.0)));
+            runs.extend([("d", 2.0), ("u", 2.0)]);
+            let (hist, o) = history(&runs);
+            let h = held(&hist, 0, o, o + 2, 0);
+            let n = between.len() as u32;
+            follow(&lib, &hist, &h, &cand(1, o + 3 + n, o + 4 + n, false))
+        };
+        // Up to CONTINUE_GAP_RUNS strokes between: still its settling.
+        assert_eq!(with_between(&["_", "f", "b", "_"]), Follow::Settles);
+        // One more: a new event.
+        assert_eq!(with_between(&["f", "b", "f"]), Follow::New);
+    }
+}
