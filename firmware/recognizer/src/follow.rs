@@ -231,6 +231,25 @@ mod tests {
     }
 
     #[test]
+    fn a_long_event_is_read_from_its_end() {
+        let blob = seq_library(&[(&["uf", "df"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // A walk of 21 hops (42 runs, its first gone from the history), a breath, one more.
+        let mut runs = std::vec::Vec::new();
+        for _ in 0..21 {
+            runs.extend([("uf", 1.0), ("df", 1.0)]);
+        }
+        runs.extend([("_", 0.0), ("uf", 1.0), ("df", 1.0)]);
+        let (hist, o) = history(&runs);
+        assert!(hist.get(o).is_none());
+        let h = held(&hist, 0, o, o + 41, 0);
+        let next = |cyclic| follow(&lib, &hist, &h, &cand(0, o + 43, o + 44, cyclic));
+        // Its next cycle continues it; a one-shot action cannot be read whole: a new event.
+        assert_eq!(next(true), Follow::Continues);
+        assert_eq!(next(false), Follow::New);
+    }
+
+    #[test]
     fn another_action_that_completes_the_held_one_is_its_rest() {
         // 0 throw `ub+ f+ db+` (one edit), 1 `db+ u+`.
         let blob = seq_library(&[(&["ub", "f", "db"], 1), (&["db", "u"], 0)]);
