@@ -114,7 +114,7 @@ pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate)
     }
     // Only stillness and a few strokes the two matches left out at their edges (a hop's
     // take-off before its `uf`) may lie between.
-    if between > CONTINUE_GAP_RUNS || i != c.end {
+    if between > CONTINUE_GAP_RUNS {
         return Follow::New;
     }
     // The held action's whole match over both.

@@ -185,6 +185,9 @@ impl<'lib> Recognizer<'lib> {
         if let Some(r) = newest.and_then(|i| hist.get(i)) {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
+                // The first sample of the pause that may commit: nothing moves during a pause,
+                // so what is checked then holds for all of it.
+                let mut first = false;
                 let longer = match (self.decider.pending(), newest) {
                     (Some(p), Some(run)) if (PAUSE_US..GAPPED_HOLD_US).contains(&still) => {
                         match self.hold {
@@ -192,6 +195,7 @@ impl<'lib> Recognizer<'lib> {
                             _ => {
                                 let v = self.longer_in_progress(&p);
                                 self.hold = Some((run, v));
+                                first = true;
                                 v
                             }
                         }
@@ -204,7 +208,9 @@ impl<'lib> Recognizer<'lib> {
                     // Held for a longer action that may yet take it over, or for the next
                     // cycle of a cyclic one: reported after the usual pause, and revised if
                     // it is taken over or goes on.
-                    if still >= PAUSE_US {
+                    // Once per pause: weighing what follows an event is a rare cost, not a
+                    // per-sample one.
+                    if first {
                         self.report_provisional(p, &mut emit);
                     }
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
