@@ -551,8 +551,10 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         }
         // The whole gesture may repeat (cyclic actions: walk, wave …; a repeated one-shot
         // action is then one event over all repetitions). A stroke every example repeats
-        // (a run's strides) is cyclic too: strides after a short pause continue the run.
-        let re = if cyclic || doubled.is_some() {
+        // (a run's strides) is cyclic too: strides after a short pause continue the run. So
+        // is an action of one stroke (a turn): the stroke resumed after a breath is the same
+        // action going on, a turn made in two twists.
+        let re = if cyclic || doubled.is_some() || mandatory.len() == 1 {
             Regex::Plus(Box::new(Regex::Cat(items)))
         } else {
             Regex::Cat(items)
@@ -1070,6 +1072,30 @@ mod tests {
         let seqs = vec![seq("f:0.3 f.Zp:0.1 f:0.3"), seq("f:0.6")];
         let re = learn_regex(&seqs).unwrap();
         assert!(re.compile().unwrap().accepts(&[f]), "{}", re.to_source());
+    }
+
+    #[test]
+    fn an_action_of_one_stroke_goes_on_when_the_stroke_resumes() {
+        // Turns: one twist each, with a little settling in one.
+        let seqs = vec![
+            seq(".Yn:0.5"),
+            seq("df:0.05 .Yn:0.6 u:0.05"),
+            seq(".Yn:0.4"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        assert!(c.cyclic, "{}", re.to_source());
+        let t = |s: &str| parse_token(s).unwrap();
+        // A turn in two twists, with its settling between them, is one match.
+        assert!(
+            c.accepts(&[t(".Yn"), t("u"), t(".Yn")]),
+            "{}",
+            re.to_source()
+        );
+        // A two-stroke action does not become cyclic by this.
+        let seqs = vec![seq("b:0.3 f:0.3"), seq("b:0.2 f:0.4")];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(!re.compile().unwrap().cyclic, "{}", re.to_source());
     }
 
     #[test]
