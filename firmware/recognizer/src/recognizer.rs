@@ -206,10 +206,9 @@ impl<'lib> Recognizer<'lib> {
                     self.commit(c, &mut emit);
                 } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
                     // Held for a longer action that may yet take it over, or for the next
-                    // cycle of a cyclic one: reported after the usual pause, and revised if
-                    // it is taken over or goes on.
-                    // Once per pause: weighing what follows an event is a rare cost, not a
-                    // per-sample one.
+                    // cycle of a cyclic one: reported after the usual pause (weighed once per
+                    // pause, not on every sample of it), and revised if it is taken over or
+                    // goes on.
                     if first {
                         self.report_provisional(p, &mut emit);
                     }
@@ -250,7 +249,7 @@ impl<'lib> Recognizer<'lib> {
         }
         // Nor once its runs are leaving the history. (A next cycle of many runs — a walk's
         // two hops — is still under way well past a few runs; what moved in between is
-        // checked by `continues`.)
+        // checked by `follow`.)
         if let (Some(h), Some(n)) = (self.held, newest) {
             if n.wrapping_sub(h.end_run) >= HISTORY_RUNS as u32 {
                 self.held = None;
