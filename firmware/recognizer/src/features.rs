@@ -32,6 +32,9 @@ pub const QUANTITIES: usize = 29;
 /// Index of the world speed (m/s) among the quantities; 0, 1, 2 are |velocity| along the
 /// object's left, up and front axes.
 pub const SPEED: usize = 18;
+/// Index of |angular velocity| about the object's x axis (rad/s) among the quantities; y and z
+/// follow.
+pub const ANGVEL: usize = 3;
 /// Floor of a mean world speed (m/s) wherever one divides by it: 1 mm/s.
 pub const SPEED_FLOOR: f32 = 1e-3;
 /// Segment features: mean and relative spread of each quantity.
@@ -181,6 +184,12 @@ pub fn motion_shape(sums: [f32; 3], speed: f32, n: u32) -> [f32; 3] {
 }
 
 impl Accum {
+    /// Σ over the ticks of |ω| about the three object axes, rad/s (× [`TICK_S`]: the angle
+    /// turned, rad, counting each axis).
+    pub fn turn_sum(&self) -> f32 {
+        self.sum[ANGVEL] + self.sum[ANGVEL + 1] + self.sum[ANGVEL + 2]
+    }
+
     /// The motion shape of these ticks ([`motion_shape`]).
     pub fn shape(&self) -> [f32; 3] {
         motion_shape(

@@ -143,8 +143,7 @@ pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate)
 /// Path length plus [`ARM_M`] × angle turned, as sums over ticks (÷ the tick rate, metres;
 /// only ratios are used).
 fn motion(a: &Accum) -> f32 {
-    let s = &a.sum;
-    s[SPEED] + ARM_M * (s[3] + s[4] + s[5])
+    a.sum[SPEED] + ARM_M * a.turn_sum()
 }
 
 #[cfg(test)]

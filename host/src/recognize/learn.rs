@@ -174,7 +174,7 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
         .map(|r| {
             let t = r.token;
             let (lin, ang) = (t / 27, t % 27);
-            let angle = dt * f64::from(r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]);
+            let angle = dt * f64::from(r.acc.turn_sum());
             let dist = dt * f64::from(r.acc.sum[SPEED]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
                 (lin * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)

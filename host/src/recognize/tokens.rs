@@ -45,7 +45,7 @@ pub fn run(args: &TokensArgs) -> Result<()> {
                 clock.time_of(r.end.0),
                 TokenName(r.token).to_string(),
                 r.acc.sum[SPEED] / n,
-                (r.acc.sum[3] + r.acc.sum[4] + r.acc.sum[5]) / n,
+                r.acc.turn_sum() / n,
             )?;
         }
     }
