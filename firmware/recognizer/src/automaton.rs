@@ -169,12 +169,16 @@ fn reverse_search(
         r & !1
     };
     // Before reading: the end, and the positions trailing deletions (each FULL) reach.
+    // Each level's states, and what they reach one step back (`rev` of them): a level's step
+    // back after one token is its step back before the next, so each is computed once.
     let mut d = [0u64; LEVELS];
+    let mut back = [0u64; LEVELS];
     let (mut n1, mut g1, mut g2) = (0u64, 0u64, 0u64);
-    for (v, slot) in d.iter_mut().enumerate().take(top + 1) {
+    for (v, (slot, b)) in d.iter_mut().zip(back.iter_mut()).enumerate().take(top + 1) {
         let n = if v == 0 { END } else { n1 } | g2;
         *slot = n;
         let g = rev(n);
+        *b = g;
         (n1, g2, g1) = (n, g1, g);
     }
     let mut j = 0;
@@ -186,9 +190,11 @@ fn reverse_search(
         let mut started = false;
         let mut v = 0;
         while v <= top {
-            let Some(slot) = d.get_mut(v) else { break };
+            let (Some(slot), Some(b)) = (d.get_mut(v), back.get_mut(v)) else {
+                break;
+            };
             let old = *slot;
-            let f0 = rev(old);
+            let f0 = *b;
             let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
             *slot = new;
             live |= new != 0;
@@ -201,6 +207,7 @@ fn reverse_search(
                 top = top.min(usize::from(on_start(j, v as u8)));
             }
             let g0 = rev(new);
+            *b = g0;
             (o2, o1, f2, f1) = (o1, old, f1, f0);
             (n1, g2, g1) = (new, g1, g0);
             v += 1;

@@ -28,13 +28,15 @@ use crate::token::{Token, STILL};
 pub const NEAREST_MAX_TOKENS: usize = 24;
 
 /// The moving tokens of the phrase that ends at run `last` (the run before the current
-/// pause): back to the previous pause of at least [`HOLD_US`]. None when the phrase reaches
-/// back to `floor` (part of it was committed already, or matching restarted inside it) or past
-/// the history, or is longer than [`NEAREST_MAX_TOKENS`]. Returns the tokens oldest first, and
-/// the phrase's first and last moving runs.
+/// pause): back to the previous pause of at least [`HOLD_US`], or to `floor` when that
+/// `bounds` a phrase (the stream began there: a child who starts playing right away). None
+/// when the phrase reaches back to any other `floor` (part of it was emitted already) or
+/// past the history, or is longer than [`NEAREST_MAX_TOKENS`]. Returns the tokens oldest
+/// first, and the phrase's first and last moving runs.
 fn phrase(
     hist: &History,
     floor: u32,
+    bounds: bool,
     last: u32,
     tok: &mut [Token; NEAREST_MAX_TOKENS],
 ) -> Option<(usize, u32, u32)> {
@@ -49,6 +51,9 @@ fn phrase(
     let mut i = last;
     for _ in 0..HISTORY_RUNS {
         if i.wrapping_sub(floor) > span {
+            if bounds {
+                break;
+            }
             // Below the floor: the phrase is not whole.
             return None;
         }
@@ -87,13 +92,19 @@ pub struct Nearest {
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
 /// phrase, when one is near enough ([`EDIT_SHARE`]). Ties of cost per aligned token go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
-/// longer than [`NEAREST_MAX_TOKENS`].
+/// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary ([`phrase`]).
 // Once per pause at most: kept out of the per-sample path (flash, not speed).
 #[cold]
 #[inline(never)]
-pub fn nearest_action(lib: &Library<'_>, hist: &History, floor: u32, last: u32) -> Option<Nearest> {
+pub fn nearest_action(
+    lib: &Library<'_>,
+    hist: &History,
+    floor: u32,
+    bounds: bool,
+    last: u32,
+) -> Option<Nearest> {
     let mut tok = [STILL; NEAREST_MAX_TOKENS];
-    let (n, first, last) = phrase(hist, floor, last, &mut tok)?;
+    let (n, first, last) = phrase(hist, floor, bounds, last, &mut tok)?;
     let tokens = tok.get(..n).unwrap_or(&[]);
     // A phrase some action could still go on from is no gesture of its own: nothing to weigh.
     if (0..lib.len())
@@ -181,7 +192,7 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         // A punch without its wind-up: one deletion in three aligned tokens.
         let h = history(&[("_", 800), ("f", 200), ("b", 200), ("_", 150)]);
-        let n = nearest_action(&lib, &h, 0, 2).unwrap();
+        let n = nearest_action(&lib, &h, 0, false, 2).unwrap();
         let c = n.candidate.unwrap();
         assert_eq!(
             (c.action, c.start, c.end, c.distance(), c.cost),
@@ -196,11 +207,17 @@ mod tests {
             ("db", 200),
             ("_", 150),
         ]);
-        let c = nearest_action(&lib, &h, 0, 3).unwrap().candidate.unwrap();
+        let c = nearest_action(&lib, &h, 0, false, 3)
+            .unwrap()
+            .candidate
+            .unwrap();
         assert_eq!((c.action, c.cost, c.distance()), (2, HALF, 1));
         // Without its drop back as well, it is too far: 1.5 edits in 3 aligned tokens.
         let h = history(&[("_", 800), ("f.Xn", 200), ("b.Xp", 200), ("_", 150)]);
-        assert_eq!(nearest_action(&lib, &h, 0, 2).unwrap().candidate, None);
+        assert_eq!(
+            nearest_action(&lib, &h, 0, false, 2).unwrap().candidate,
+            None
+        );
     }
 
     #[test]
@@ -209,10 +226,13 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         // Nothing like any action.
         let h = history(&[("_", 800), ("l", 200), ("r", 200), ("l", 200), ("_", 150)]);
-        assert_eq!(nearest_action(&lib, &h, 0, 3).unwrap().candidate, None);
+        assert_eq!(
+            nearest_action(&lib, &h, 0, false, 3).unwrap().candidate,
+            None
+        );
         // A crouch's way down, held: the crouch may still rise.
         let h = history(&[("_", 800), ("d", 300), ("_", 150)]);
-        assert!(nearest_action(&lib, &h, 0, 1).unwrap().open);
+        assert!(nearest_action(&lib, &h, 0, false, 1).unwrap().open);
         // A pause shorter than a hold lies inside the phrase, which reaches the floor there.
         let h = history(&[
             ("_", 800),
@@ -222,13 +242,38 @@ mod tests {
             ("b", 200),
             ("_", 150),
         ]);
-        assert_eq!(nearest_action(&lib, &h, 3, 4), None);
-        let c = nearest_action(&lib, &h, 0, 4).unwrap().candidate.unwrap();
+        assert_eq!(nearest_action(&lib, &h, 3, false, 4), None);
+        let c = nearest_action(&lib, &h, 0, false, 4)
+            .unwrap()
+            .candidate
+            .unwrap();
         assert_eq!((c.action, c.start, c.end, c.cost), (0, 1, 4, 0));
         // The last run below the floor (committed), or no motion at all.
-        assert_eq!(nearest_action(&lib, &h, 5, 4), None);
+        assert_eq!(nearest_action(&lib, &h, 5, false, 4), None);
         let h = history(&[("_", 800), ("_", 150)]);
-        assert_eq!(nearest_action(&lib, &h, 0, 0), None);
+        assert_eq!(nearest_action(&lib, &h, 0, false, 0), None);
+    }
+
+    #[test]
+    fn the_start_of_the_stream_bounds_a_phrase() {
+        let blob = lib_blob();
+        let lib = Library::from_bytes(&blob).unwrap();
+        // Played right away: less stillness before the punch than a hold.
+        let h = history(&[("_", 300), ("f", 200), ("b", 200), ("_", 150)]);
+        let c = nearest_action(&lib, &h, 0, true, 2)
+            .unwrap()
+            .candidate
+            .unwrap();
+        assert_eq!((c.action, c.start, c.end, c.cost), (0, 1, 2, FULL));
+        // The same runs after an event that ended at the floor: not a whole phrase.
+        assert_eq!(nearest_action(&lib, &h, 0, false, 2), None);
+        // The stream began in motion: the phrase starts with it.
+        let h = history(&[("f", 200), ("b", 200), ("_", 150)]);
+        let c = nearest_action(&lib, &h, 0, true, 1)
+            .unwrap()
+            .candidate
+            .unwrap();
+        assert_eq!((c.start, c.end), (0, 1));
     }
 
     #[test]
@@ -240,7 +285,7 @@ mod tests {
         runs.push(("_", 150));
         let h = history(&runs);
         assert_eq!(
-            nearest_action(&lib, &h, 0, (NEAREST_MAX_TOKENS + 1) as u32),
+            nearest_action(&lib, &h, 0, false, (NEAREST_MAX_TOKENS + 1) as u32),
             None
         );
     }

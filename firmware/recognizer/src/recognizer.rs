@@ -83,6 +83,10 @@ pub struct Recognizer<'lib> {
     bank: MatcherBank,
     decider: Decider,
     floor: u32,
+    /// Where a stand-alone phrase ([`nearest_action`]) may begin at the earliest: after the
+    /// last event emitted (a match too brief to emit leaves it), and whether it is a phrase
+    /// boundary of its own — where the stream began, a gap cut it, or a long pause passed.
+    phrase_floor: (u32, bool),
     tokens: u32,
     events: u32,
     now_us: u64,
@@ -108,6 +112,7 @@ impl<'lib> Recognizer<'lib> {
             bank: MatcherBank::new(),
             decider: Decider::new(),
             floor: 0,
+            phrase_floor: (0, true),
             tokens: 0,
             events: 0,
             now_us: 0,
@@ -149,6 +154,7 @@ impl<'lib> Recognizer<'lib> {
             .history()
             .newest()
             .map_or(0, |n| n.wrapping_add(1));
+        self.phrase_floor = (self.floor, true);
     }
 
     /// Feeds one sample; `emit` receives each action committed by it (in time order).
@@ -173,6 +179,7 @@ impl<'lib> Recognizer<'lib> {
             self.bank.reset();
             self.provisional = None;
             self.floor = self.front.history().oldest().unwrap_or(0);
+            self.phrase_floor = (self.floor, true);
         }
         for (index, token) in opened.iter().flatten().copied() {
             if token != STILL {
@@ -226,7 +233,8 @@ impl<'lib> Recognizer<'lib> {
                             let n = nearest_action(
                                 &self.library,
                                 hist,
-                                self.floor,
+                                self.phrase_floor.0,
+                                self.phrase_floor.1,
                                 run.wrapping_sub(1),
                             );
                             self.nearest = Some((run, n));
@@ -423,15 +431,15 @@ impl<'lib> Recognizer<'lib> {
             let Some(p) = self.library.pattern(a) else {
                 continue;
             };
-            // The match of the highest merit ending here at the lowest cost `d` — or, for a
-            // cyclic action, at one half-edit more: a run's many strides with a wobble among
-            // them outrank the few exact ones after it (and a walk's piece of them). Wider
-            // searches recognised no better and cost the MCU more (mean instructions per sample
-            // at 32 actions: every cost up to the bound 5,216, half an edit more for every
-            // action 4,977, this 4,829–4,850; goal 5,000). Held to the share of edits per token
-            // (in half-edits) as well as to the action's bound.
+            // The match of the highest merit ending here at up to one edit more than the
+            // lowest cost `d`: a crouch whose descent wobbled once outranks a jump that
+            // explains the descent for free and leaves out its landing, and a run's many
+            // strides with a wobble among them outrank the few exact ones after it. (At the
+            // lowest cost only, for one-shot actions, isolated gestures were 0.3–0.6 points
+            // worse; every cost up to the bound was no better than this.) Held to the share of
+            // edits per token (in half-edits) as well as to the action's bound.
             let min_len = p.min_len();
-            let reach = usize::from(d) + usize::from(p.cyclic());
+            let reach = usize::from(d) + usize::from(FULL);
             let Some((j, cost, _)) = best_start(
                 &p,
                 reach.min(top_level(&p)).min(255) as u8,
@@ -473,6 +481,7 @@ impl<'lib> Recognizer<'lib> {
         if let Some((ev, continues, held)) = self.outcome(&p, before) {
             self.provisional = Some((p, before, continues));
             self.held = held;
+            self.phrase_floor = (p.end.wrapping_add(1), false);
             self.emit_held(ev, continues, emit);
         }
     }
@@ -573,6 +582,7 @@ impl<'lib> Recognizer<'lib> {
         let Some((ev, revises, held)) = out else {
             return;
         };
+        self.phrase_floor = (self.floor, false);
         self.held = held;
         match provisional {
             // Reported already, exactly so.
@@ -902,6 +912,59 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    /// Quick strokes (0.12 s each, 5 cm, along `dirs`), 0.15 s apart, played right after the
+    /// stream starts; then still.
+    fn quick_strokes(dirs: &[[f32; 3]]) -> Vec<Sample> {
+        let rate = 200.0f32;
+        let (lead, stroke, gap) = (0.3f32, 0.12f32, 0.15f32);
+        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
+        let total = lead + dirs.len() as f32 * (stroke + gap) + 1.0;
+        (0..(total * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let mut pos = [0.3f32, 1.0, 0.0];
+                for (k, d) in dirs.iter().enumerate() {
+                    let x = ramp((t - lead - k as f32 * (stroke + gap)) / stroke);
+                    for (p, v) in pos.iter_mut().zip(d) {
+                        *p += 0.05 * x * v;
+                    }
+                }
+                Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos,
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn strokes_too_brief_for_a_gesture_stay_in_their_phrase() {
+        // Each `l` alone matches but is too brief to emit; the `u` between matches nothing.
+        // The three strokes, right after the stream began, are one phrase: its nearest action.
+        let blob = seq_library(&[(&["l"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let left = [1.0, 0.0, 0.0];
+        let ev = run(&lib, &quick_strokes(&[left, [0.0, 1.0, 0.0], left]));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert!(ev[0].start_us < 400_000 && ev[0].end_us > 900_000, "{ev:?}");
+        // A stroke alone stays too brief.
+        assert_eq!(run(&lib, &quick_strokes(&[left])), [], "one stroke");
+    }
+
+    #[test]
+    fn a_match_reaches_back_over_a_wobble_at_the_start() {
+        // `d u` costs nothing from the plain part of the descent on, and half an edit from
+        // its pitched start: the whole descent is the crouch.
+        let blob = seq_library(&[(&["d", "u"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &crouch_held_low(0.5));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert!(ev[0].start_us < 700_000, "{ev:?}");
+        assert_eq!(ev[0].distance, 1, "{ev:?}");
     }
 
     #[test]

@@ -9,9 +9,10 @@
 //!    counts samples; durations make the rule independent of the sample rate.
 //! 4. The mandatory strings of the examples are aligned to the average's by edit-distance
 //!    alignment. Column i becomes `(m_i0|…|m_in)+`, or `…*` when some example lacks it. A run
-//!    whose rotation barely turned (a wobble, [`intent_symbols`]) is written in a column as the
-//!    plain stroke or that wobble about the same axis (`f|f.Zn|f.Zp`), so a punch that rolls
-//!    does not accept a kick's pitch ([`expand_symbol`]). A pattern needs two tokens at
+//!    whose rotation barely turned (a wobble, [`intent_symbols`]) — or a plain stroke that
+//!    tilted a few degrees about one axis, too slowly for a rotation token — is written in a
+//!    column as the plain stroke or that wobble about the same axis (`f|f.Zn|f.Zp`), so a
+//!    punch that rolls does not accept a kick's pitch ([`expand_symbol`]). A pattern needs two tokens at
 //!    least: when its only mandatory column is a part every example performs twice or more
 //!    (a run's strides), that column is written twice.
 //! 5. The optional tokens found between two columns become `(o_1|…|o_k)*` before the later
@@ -30,7 +31,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
-use figurine_recognizer::features::SPEED;
+use figurine_recognizer::features::{Accum, ANGVEL, SPEED};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::segment::edits_fit;
 use figurine_recognizer::token::{
@@ -136,6 +137,31 @@ fn wobble_axes(t: Token) -> Symbol {
         .fold(0, |m, (i, _)| m | (1 << (WOBBLE_SHIFT as usize + i)))
 }
 
+/// Angle (rad, ≈ 7°) a plain stroke must turn about one axis for that turn to count as a
+/// wobble of it ([`slow_wobble_axis`]).
+pub const SLOW_WOBBLE_RAD: f64 = 0.12;
+/// Share of a plain stroke's turning that one axis needs to be its wobble axis.
+pub const SLOW_WOBBLE_SHARE: f64 = 0.6;
+
+/// The axis a plain stroke (`d`: translation, no rotation token) tilted about, when it did so
+/// by [`SLOW_WOBBLE_RAD`] or more and mostly about that one axis: too slowly for a rotation
+/// token, as a sustained performance tilts, while a sudden performance of the same stroke
+/// turns as far in less time and is written `d.Xp`. Learning such a stroke as its wobble
+/// (`d|d.Xn|d.Xp`) keeps the pattern from depending on the examples' speed.
+fn slow_wobble_axis(acc: &Accum, t: Token) -> Option<u16> {
+    let (lin, ang) = (t / 27, t % 27);
+    if lin == NONE_BIN || ang != NONE_BIN {
+        return None;
+    }
+    let dt = f64::from(figurine_recognizer::intake::TICK_S);
+    let a: Vec<f64> = (0..3)
+        .map(|i| dt * f64::from(acc.sum[ANGVEL + i]))
+        .collect();
+    let total: f64 = a.iter().sum();
+    let (axis, &most) = a.iter().enumerate().max_by(|x, y| x.1.total_cmp(y.1))?;
+    (most >= SLOW_WOBBLE_RAD && most >= SLOW_WOBBLE_SHARE * total).then_some(axis as u16)
+}
+
 /// The symbols a learnt symbol stands for in a written pattern: a wildcard with wobble axes
 /// becomes the plain token plus both signs about its one axis (a wobble about two or three
 /// axes stays the full wildcard); every other symbol stands for itself.
@@ -178,6 +204,8 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
             let dist = dt * f64::from(r.acc.sum[SPEED]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
                 (lin * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
+            } else if let Some(axis) = slow_wobble_axis(&r.acc, t) {
+                (lin * 27 + NONE_BIN) | ANY_ROT | (1 << (WOBBLE_SHIFT + axis))
             } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
                 (NONE_BIN * 27 + ang) | ANY_LIN
             } else {
@@ -848,6 +876,34 @@ mod tests {
     use super::*;
     use crate::synth::{self, Action, Knobs};
     use figurine_recognizer::token::parse_token;
+
+    #[test]
+    fn a_plain_stroke_that_tilted_slowly_is_learnt_as_its_wobble() {
+        // Σ|ω| per axis in rad/s over 10 ms ticks: 15 → 0.15 rad about X.
+        let mut acc = Accum::new();
+        acc.sum[ANGVEL] = 15.0;
+        acc.sum[ANGVEL + 2] = 3.0;
+        let d = parse_token("d").unwrap();
+        assert_eq!(slow_wobble_axis(&acc, d), Some(0));
+        // Already a rotation token: the incidental-angle rule decides, not this one.
+        assert_eq!(slow_wobble_axis(&acc, parse_token("d.Xp").unwrap()), None);
+        // Tilting about two axes alike, or too little: no one wobble axis.
+        acc.sum[ANGVEL + 2] = 12.0;
+        assert_eq!(slow_wobble_axis(&acc, d), None);
+        let mut small = Accum::new();
+        small.sum[ANGVEL + 1] = 8.0;
+        assert_eq!(slow_wobble_axis(&small, d), None);
+        // The symbol is written as the plain stroke and its two wobbles about that axis.
+        let sym = (d | ANY_ROT) | (1 << WOBBLE_SHIFT);
+        let mut out = expand_symbol(sym);
+        out.sort_unstable();
+        let mut want: Vec<Symbol> = ["d", "d.Xn", "d.Xp"]
+            .iter()
+            .map(|n| parse_token(n).unwrap())
+            .collect();
+        want.sort_unstable();
+        assert_eq!(out, want);
+    }
 
     #[test]
     fn a_walk_bobs_where_a_run_skims_and_a_sidestep_goes_sideways() {
