@@ -12,11 +12,16 @@
 //! with these costs, in half-edits: insertion, deletion and substitution [`FULL`]; a
 //! substitution [`HALF`] between two moving tokens that differ only in their rotation half, or
 //! only in one component of their translation direction at the same rotation (`uf` for `f`:
-//! 45° apart). Like the automata it is bit-parallel over the pattern's Glushkov states: one
-//! `u64` set per cost level, `D[v]` = the states some alignment of the tokens read so far
-//! reaches at cost ≤ v. With `B`/`H` the positions a token matches exactly / at half cost:
+//! 45° apart). And one token may stand for a position it matches exactly and the next one,
+//! which it is near, at [`HALF`]: a stroke that did not drift across a bin border, where the
+//! examples' did (`b.Xp` for a kick's return `b.Xp+ db.Xp+`, which curved down in every
+//! example) — not a missing stroke, which costs [`FULL`]. Like the automata it is
+//! bit-parallel over the pattern's Glushkov states: one `u64` set per cost level, `D[v]` =
+//! the states some alignment of the tokens read so far reaches at cost ≤ v. With `B`/`H` the
+//! positions a token matches exactly / at half cost:
 //! ```text
 //! D'[v] = T(D[v]) ∩ B  ∪  T(D[v−1]) ∩ H  ∪  T(D[v−2])   match, half and full substitution
+//!       ∪ T(T(D[v−1]) ∩ B) ∩ H                            one stroke for two positions
 //!       ∪ D[v−2]  ∪  D'[v−1]  ∪  T(D'[v−2])               insertion, monotone, deletion
 //! ```
 //! The automata read each token with the same update (`advance`), adding at every token the
@@ -117,7 +122,9 @@ pub(crate) fn advance(p: &Pattern<'_>, d: &mut [u64], c: Token, anywhere: bool) 
         };
         let old = *slot | iv;
         let f0 = p.forward(old);
-        let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
+        // One stroke for a position read exactly and the next one near (module docs).
+        let merge = p.forward(f1 & exact) & near;
+        let new = (f0 & exact) | (f1 & near) | merge | f2 | o2 | n1 | g2;
         *slot = new;
         if best.is_none() && new & last != 0 {
             best = Some(v as u8);
@@ -253,6 +260,19 @@ mod tests {
                             2
                         };
                         next[q] = next[q].min(d[from] + sub);
+                        // One stroke read as `q` exactly and as the next position `r` near
+                        // (not exactly: `f+ f+` still asks for two strides).
+                        if sub == 0 {
+                            for r in 1..=n {
+                                let rs = p.symbol(r);
+                                if p.follow(q) & (1 << r) != 0
+                                    && near_ref(rs, c)
+                                    && !symbol_matches(rs, c)
+                                {
+                                    next[r] = next[r].min(d[from] + 1);
+                                }
+                            }
+                        }
                     }
                 }
             }
@@ -274,6 +294,11 @@ mod tests {
         assert_eq!(cost(&["d", "uf"], "d f"), Some(HALF));
         assert_eq!(cost(&["d", "u"], "d f"), Some(FULL));
         assert_eq!(cost(&["d", "uf.Xn"], "d f"), Some(FULL));
+        // A return that did not curve into the next position's direction: half an edit;
+        // but one stride is no two (`f+ f+`), and a stroke near neither position is missing.
+        assert_eq!(cost(&["b.Xp", "db.Xp"], "b.Xp"), Some(HALF));
+        assert_eq!(cost(&["f", "f"], "f"), Some(FULL));
+        assert_eq!(cost(&["b", "u"], "b"), Some(FULL));
         // Missing landing: one deletion; an extra stroke: one insertion.
         assert_eq!(cost(&["d", "u", "d"], "d u"), Some(FULL));
         assert_eq!(cost(&["d", "u"], "d b u"), Some(FULL));

@@ -195,7 +195,10 @@ fn reverse_search(
             };
             let old = *slot;
             let f0 = *b;
-            let new = (f0 & exact) | (f1 & near) | f2 | o2 | n1 | g2;
+            // One stroke for two positions, mirrored: the later one read near, the one
+            // before it exactly (only a token's few exact positions are looked up).
+            let merge = p.backward_among(f1 & near, exact);
+            let new = (f0 & exact) | (f1 & near) | merge | f2 | o2 | n1 | g2;
             *slot = new;
             live |= new != 0;
             // A match may start here, at a first position of the pattern (leading deletions

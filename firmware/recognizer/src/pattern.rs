@@ -27,7 +27,9 @@
 //! then (version 2) the shape table, 4 bytes per action in record order:
 //! +0  3   the action's motion shape: mean |velocity| along left, up, front (object frame)
 //!         over its examples, each as a share of the mean speed, × 255 rounded
-//! +3  1   1 = shape known (learnt from examples), 0 = unknown (the three bytes are zero)
+//! +3  1   0 = shape unknown (the three bytes are zero); else shape known (learnt from
+//!         examples), and 1 + 254 × how far the examples' shapes lay from it (the largest
+//!         distance, rounded; 1 = the examples agree, or a library from before the spread)
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -160,6 +162,20 @@ impl<'a> Pattern<'a> {
     pub fn forward_outlined(&self, d: u64) -> u64 {
         self.forward(d)
     }
+    /// [`Pattern::backward`] of `d`, only among the states `among` (few: a token's exact or
+    /// near positions): reads just their follow sets.
+    pub fn backward_among(&self, d: u64, among: u64) -> u64 {
+        let mut out = 0u64;
+        let mut x = if d == 0 { 0 } else { among };
+        while x != 0 {
+            let i = x.trailing_zeros() as usize;
+            if self.follow(i) & d != 0 {
+                out |= 1 << i;
+            }
+            x &= x - 1;
+        }
+        out
+    }
     /// Backward transition: all states with a successor in `d`.
     pub fn backward(&self, d: u64) -> u64 {
         // Dead cost levels are common in the reverse search; reading every follow set for
@@ -246,7 +262,7 @@ impl<'a> Library<'a> {
                 .ok_or(Error::Truncated)?;
             for s in table.chunks_exact(SHAPE_BYTES) {
                 match s {
-                    [_, _, _, 1] | [0, 0, 0, 0] => {}
+                    [_, _, _, 1..=255] | [0, 0, 0, 0] => {}
                     _ => return Err(Error::Invalid("shape table")),
                 }
             }
@@ -272,8 +288,21 @@ impl<'a> Library<'a> {
         }
         let at = usize::from(self.shapes) + SHAPE_BYTES * i;
         match *self.bytes.get(at..at + SHAPE_BYTES)? {
-            [l, u, f, 1] => Some([l, u, f].map(|b| f32::from(b) / 255.0)),
+            [l, u, f, 1..=255] => Some([l, u, f].map(|b| f32::from(b) / 255.0)),
             _ => None,
+        }
+    }
+
+    /// How far the examples' shapes of action `i` lay from [`Library::shape`] (the largest
+    /// distance, in shares of speed; 0 when not known).
+    pub fn shape_spread(&self, i: usize) -> f32 {
+        if self.shapes == 0 || i >= self.n {
+            return 0.0;
+        }
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i + 3;
+        match self.bytes.get(at) {
+            Some(&k) if k > 1 => f32::from(k - 1) / 254.0,
+            _ => 0.0,
         }
     }
 
@@ -469,14 +498,22 @@ pub(crate) mod tests {
         assert_eq!(lib.shape(1), None);
         assert_eq!(lib.shape(2), None);
         assert_eq!(lib.pattern(1).unwrap().positions(), 2);
-        // A missing or partial table, a bad flag, stray bytes after an unknown shape.
+        assert_eq!((lib.shape_spread(0), lib.shape_spread(1)), (0.0, 0.0));
+        // The flag byte also carries how far the examples' shapes spread: 1 + 51 → 51 / 254.
+        let mut spread = v2.clone();
+        let flag = spread.len() - SHAPE_BYTES - 1;
+        spread[flag] = 1 + 51;
+        let lib = Library::from_bytes(&spread).unwrap();
+        assert_eq!(lib.shape(0), Some([0.0, 1.0, 0.2]));
+        assert_eq!(lib.shape_spread(0), 51.0 / 254.0);
+        // A missing or partial table, a known shape without its flag, stray bytes after an
+        // unknown shape.
         assert_eq!(
             Library::from_bytes(&v2[..v2.len() - 1]).err(),
             Some(Error::Truncated)
         );
         let mut bad = v2.clone();
-        let flag = bad.len() - SHAPE_BYTES - 1;
-        bad[flag] = 2;
+        bad[flag] = 0;
         assert!(Library::from_bytes(&bad).is_err());
         let mut bad = v2.clone();
         let last = bad.len() - 2;

@@ -607,7 +607,11 @@ impl<'lib> Recognizer<'lib> {
 #[inline(never)]
 fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u32) -> i16 {
     match library.shape(a) {
-        Some(expected) => shape_penalty(expected, observed_shape(hist, start, end)),
+        Some(expected) => shape_penalty(
+            expected,
+            library.shape_spread(a),
+            observed_shape(hist, start, end),
+        ),
         None => 0,
     }
 }

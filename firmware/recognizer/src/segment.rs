@@ -37,19 +37,22 @@ pub const SHAPE_CAP: i16 = 4;
 
 /// The merit (quarter tokens) a match loses when its motion shape `observed` — mean
 /// |velocity| along the object's left, up and front axes as shares of the mean speed — is
-/// unlike its action's `expected` one: [`SHAPE_WEIGHT`] × the squared distance, at most
-/// [`SHAPE_CAP`]. Tokens only know which way each stroke went, to 45°; the shape keeps how
-/// much: a walk's hops bob, a run's strides skim, though both are written `uf f df`.
-pub fn shape_penalty(expected: [f32; 3], observed: [f32; 3]) -> i16 {
+/// unlike its action's `expected` one: [`SHAPE_WEIGHT`] × the squared distance beyond
+/// `spread` (how far the action's own examples lay from `expected`), at most [`SHAPE_CAP`].
+/// Tokens only know which way each stroke went, to 45°; the shape keeps how much: a walk's
+/// hops bob, a run's strides skim, though both are written `uf f df`. Where the examples
+/// themselves varied (a kick flicked flat or high), so may a performance, at no cost.
+pub fn shape_penalty(expected: [f32; 3], spread: f32, observed: [f32; 3]) -> i16 {
     let mut d2 = 0.0;
     for (e, o) in expected.iter().zip(observed.iter()) {
         d2 += (e - o) * (e - o);
     }
-    if !fmath::is_finite(d2) {
-        // A degenerate shape: no evidence either way.
+    if !fmath::is_finite(d2) || d2 <= spread * spread {
+        // A degenerate shape (no evidence either way), or one as close as the examples'.
         return 0;
     }
-    fmath::min(SHAPE_WEIGHT * d2, f32::from(SHAPE_CAP)) as i16
+    let beyond = fmath::sqrt(d2) - spread;
+    fmath::min(SHAPE_WEIGHT * beyond * beyond, f32::from(SHAPE_CAP)) as i16
 }
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
@@ -281,14 +284,19 @@ mod tests {
     #[test]
     fn a_shape_unlike_the_actions_costs_up_to_one_token() {
         let walk = [0.1, 0.55, 0.75];
-        assert_eq!(shape_penalty(walk, walk), 0);
+        assert_eq!(shape_penalty(walk, 0.0, walk), 0);
         // A run's flatter strides: 0.3 less up, 0.1 more front → 50 × 0.1 = 5 → capped at 4.
-        assert_eq!(shape_penalty(walk, [0.1, 0.25, 0.85]), SHAPE_CAP);
+        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.25, 0.85]), SHAPE_CAP);
         // A little off: 50 × 0.04² ≈ 0.08 → nothing.
-        assert_eq!(shape_penalty(walk, [0.1, 0.51, 0.75]), 0);
+        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.51, 0.75]), 0);
         // 50 × 0.2² = 2 quarter tokens.
-        assert_eq!(shape_penalty(walk, [0.1, 0.35, 0.75]), 2);
-        assert_eq!(shape_penalty(walk, [f32::NAN, 0.5, 0.7]), 0);
+        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.35, 0.75]), 2);
+        assert_eq!(shape_penalty(walk, 0.0, [f32::NAN, 0.5, 0.7]), 0);
+        // Where the examples lay up to 0.1 away, only what lies beyond counts: 50 × 0.1² = 0.5
+        // → nothing; 50 × 0.2² = 2.
+        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.45, 0.75]), 0);
+        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.35, 0.75]), 0);
+        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.25, 0.75]), 2);
         // Taken off the merit: an exact tie goes to the matching shape.
         let a = Candidate {
             shape: 0,

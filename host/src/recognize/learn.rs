@@ -95,6 +95,19 @@ pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
     gesture_accum(log).map(|acc| acc.shape())
 }
 
+/// How far the examples' shapes lie from their mean ([`mean_shape`]): the largest distance
+/// of one from it. None when none moved.
+pub fn shape_spread(logs: &[PoseLog]) -> Option<f32> {
+    let mean = mean_shape(logs)?;
+    logs.iter()
+        .filter_map(motion_shape)
+        .map(|s| {
+            let d2: f32 = s.iter().zip(&mean).map(|(a, b)| (a - b) * (a - b)).sum();
+            d2.sqrt()
+        })
+        .reduce(f32::max)
+}
+
 /// The mean motion shape of the examples ([`motion_shape`]); None when none moved.
 pub fn mean_shape(logs: &[PoseLog]) -> Option<[f32; 3]> {
     let shapes: Vec<[f32; 3]> = logs.iter().filter_map(motion_shape).collect();
@@ -788,7 +801,8 @@ pub fn learn_action(
         Some(max_edits.unwrap_or_else(|| default_edits(c.min_len()))),
         examples,
     )?
-    .with_shape(mean_shape(logs));
+    .with_shape(mean_shape(logs))
+    .with_shape_spread(shape_spread(logs));
     Ok(entry)
 }
 
@@ -933,6 +947,23 @@ mod tests {
         }
         // No motion, no shape.
         assert_eq!(mean_shape(&[]), None);
+        assert_eq!(shape_spread(&[]), None);
+    }
+
+    #[test]
+    fn a_kick_flicked_flat_or_high_spreads_its_shape_more_than_a_walk() {
+        let spread = |action: Action, seed: u64| {
+            let logs: Vec<PoseLog> = synth::examples(seed, &Knobs::default(), action, 3, None)
+                .into_iter()
+                .map(|d| d.log)
+                .collect();
+            shape_spread(&logs).unwrap()
+        };
+        // Over a few example sets: a kick's flick rises 0.3–1.4× as far as it goes forward.
+        let kick: f32 = (1..=4).map(|s| spread(Action::Kick, s)).sum();
+        let walk: f32 = (1..=4).map(|s| spread(Action::Walk, s)).sum();
+        assert!(kick > walk, "kick {kick} walk {walk}");
+        assert!(walk >= 0.0);
     }
 
     fn seq(s: &str) -> Tokenized {

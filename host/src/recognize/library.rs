@@ -42,6 +42,11 @@ pub struct ActionEntry {
     /// absent for a pattern written by hand.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<[f32; 3]>,
+    /// How far the examples' own shapes lie from [`ActionEntry::shape`] (the largest
+    /// distance, in the same shares): a match whose shape lies as close costs no merit. A kick
+    /// flicked flat or high varies where a walk's hops do not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_spread: Option<f32>,
 }
 
 /// Human-readable compiled automaton.
@@ -123,6 +128,7 @@ impl ActionEntry {
             compiled: None,
             examples,
             shape: None,
+            shape_spread: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
@@ -136,12 +142,21 @@ impl ActionEntry {
         self
     }
 
-    /// The device's shape-table entry: the three shares × 255 and the known flag.
+    /// The same entry with shape spread `spread` (see [`ActionEntry::shape_spread`]).
+    pub fn with_shape_spread(mut self, spread: Option<f32>) -> Self {
+        self.shape_spread = spread;
+        self
+    }
+
+    /// The device's shape-table entry: the three shares × 255, and 1 + the spread × 254
+    /// (0 when there is no shape).
     fn shape_bytes(&self) -> [u8; SHAPE_BYTES] {
         match self.shape {
             Some(s) if s.iter().all(|x| x.is_finite()) => {
                 let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
-                [q(s[0]), q(s[1]), q(s[2]), 1]
+                let spread = self.shape_spread.filter(|x| x.is_finite()).unwrap_or(0.0);
+                let k = 1 + (spread.clamp(0.0, 1.0) * 254.0).round() as u8;
+                [q(s[0]), q(s[1]), q(s[2]), k]
             }
             _ => [0; SHAPE_BYTES],
         }
@@ -276,7 +291,8 @@ mod tests {
         let mut lib = LibraryFile::default();
         let hop = ActionEntry::new("hop", "(uf df)+", None, vec![])
             .unwrap()
-            .with_shape(Some([0.05, 0.6, 0.8]));
+            .with_shape(Some([0.05, 0.6, 0.8]))
+            .with_shape_spread(Some(0.1));
         lib.upsert(hop);
         lib.upsert(ActionEntry::new("slide", "l+ r+ l+", Some(1), vec![]).unwrap());
         let blob = lib.blob().unwrap();
@@ -286,11 +302,14 @@ mod tests {
             assert!((got - want).abs() <= 0.5 / 255.0 + 1e-6, "{s:?}");
         }
         assert_eq!(dev.shape(1), None);
+        assert!((dev.shape_spread(0) - 0.1).abs() <= 0.5 / 254.0 + 1e-6);
+        assert_eq!(dev.shape_spread(1), 0.0);
         // The JSON keeps it; an entry without one writes no `shape` at all.
         let text = serde_json::to_string(&lib).unwrap();
         assert_eq!(text.matches("\"shape\"").count(), 1, "{text}");
         let back = LibraryFile::from_json(&text).unwrap();
         assert_eq!(back.actions[0].shape, Some([0.05, 0.6, 0.8]));
+        assert_eq!(back.actions[0].shape_spread, Some(0.1));
         assert_eq!(back.actions[1].shape, None);
     }
 }

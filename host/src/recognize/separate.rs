@@ -196,7 +196,10 @@ fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
         entry.examples.clone(),
     )
     .ok()
-    .map(|e| e.with_shape(entry.shape))
+    .map(|e| {
+        e.with_shape(entry.shape)
+            .with_shape_spread(entry.shape_spread)
+    })
 }
 
 /// Every example of every action, as (action index, source text, tokens).
