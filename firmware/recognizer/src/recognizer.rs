@@ -346,10 +346,29 @@ impl<'lib> Recognizer<'lib> {
         self.events = self.events.saturating_add(1);
     }
 
-    /// Commits the pending candidate, if any (end of stream).
+    /// Commits the pending candidate, if any (end of stream); then, if no event took the
+    /// stream's last phrase, reports its nearest action as after a pause (a log that ends
+    /// right after a gesture no action matched closely keeps that gesture).
     pub fn flush(&mut self, mut emit: impl FnMut(ActionEvent)) {
         if let Some(c) = self.decider.pending() {
             self.commit(c, &mut emit);
+        }
+        let hist = self.front.history();
+        if let Some(newest) = hist.newest() {
+            let still = hist.get(newest).is_some_and(|r| r.token == STILL);
+            let last = if still {
+                newest.wrapping_sub(1)
+            } else {
+                newest
+            };
+            let (floor, bounds) = self.phrase_floor;
+            if let Some(Nearest {
+                candidate: Some(c),
+                open: false,
+            }) = nearest_action(&self.library, hist, floor, bounds, last)
+            {
+                self.commit(c, &mut emit);
+            }
         }
         self.held = None;
     }
@@ -957,6 +976,23 @@ mod tests {
         assert!(ev[0].start_us < 400_000 && ev[0].end_us > 900_000, "{ev:?}");
         // A stroke alone stays too brief.
         assert_eq!(run(&lib, &quick_strokes(&[left])), [], "one stroke");
+    }
+
+    #[test]
+    fn a_log_that_ends_right_after_a_gesture_keeps_it() {
+        // `l r l` exactly only (bound 0): `r l` is its nearest reading, after a pause — or
+        // when the stream ends first.
+        let blob = seq_library(&[(&["l", "r", "l"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let strokes = quick_strokes(&[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]);
+        let ev = run(&lib, &strokes);
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        // The log ends 60 ms after the second stroke: too soon for any pause to pass.
+        let end_us = 300_000 + 120_000 + 150_000 + 120_000 + 60_000;
+        let cut: Vec<Sample> = strokes.into_iter().filter(|s| s.t_us <= end_us).collect();
+        let ev = run(&lib, &cut);
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert!(ev[0].start_us < 400_000, "{ev:?}");
     }
 
     #[test]
