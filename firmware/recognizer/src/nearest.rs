@@ -13,7 +13,9 @@
 //! ([`EDIT_SHARE`]), without the action's own bound; otherwise nothing is reported.
 //!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
-//! gestures. Run once per pause, over at most [`NEAREST_MAX_TOKENS`] tokens; its cost is a
+//! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
+//! away), and so does the end of a log (the recognizer's `flush`); a match too brief to be an
+//! action does not break a phrase (a sudden sidestep's hops, each matched alone). Run once per pause, over at most [`NEAREST_MAX_TOKENS`] tokens; its cost is a
 //! rare spike (measured by the firmware bench), not a per-sample one.
 
 use crate::alignment::{weighted_cost, FULL};
@@ -92,7 +94,8 @@ pub struct Nearest {
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
 /// phrase, when one is near enough ([`EDIT_SHARE`]). Ties of cost per aligned token go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
-/// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary ([`phrase`]).
+/// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary (the stream
+/// began there), not the end of an event.
 // Once per pause at most: kept out of the per-sample path (flash, not speed).
 #[cold]
 #[inline(never)]

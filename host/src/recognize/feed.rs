@@ -1,7 +1,7 @@
 //! Pose logs into the recognizer, through the wire quantisation.
 //!
 //! Host simulation must see exactly the numbers the MCU sees, so every log sample goes through
-//! [`wire_sample`]: quantised into a `figurine_protocol::Pose` (0.1 mm, smallest-three
+//! [`WireFeed::wire_sample`]: quantised into a `figurine_protocol::Pose` (0.1 mm, smallest-three
 //! quaternion, u32 µs, u16 seq) and decoded back with the same routines the firmware uses
 //! (including the wrap-extending time and sequence unwrappers). Samples the wire cannot carry
 //! (NaN, beyond ±100 m, zero quaternion) are dropped here and counted, as the link would.

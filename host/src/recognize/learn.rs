@@ -12,9 +12,9 @@
 //!    whose rotation barely turned (a wobble, [`intent_symbols`]) — or a plain stroke that
 //!    tilted a few degrees about one axis, too slowly for a rotation token — is written in a
 //!    column as the plain stroke or that wobble about the same axis (`f|f.Zn|f.Zp`), so a
-//!    punch that rolls does not accept a kick's pitch ([`expand_symbol`]). A pattern needs two tokens at
-//!    least: when its only mandatory column is a part every example performs twice or more
-//!    (a run's strides), that column is written twice.
+//!    punch that rolls does not accept a kick's pitch ([`expand_symbol`]). A pattern needs
+//!    two tokens at least: when its only mandatory column is a part every example performs
+//!    twice or more (a run's strides), that column is written twice.
 //! 5. The optional tokens found between two columns become `(o_1|…|o_k)*` before the later
 //!    column — or mandatory columns when every example has the same optional sequence there.
 //! 6. Every example is checked to be accepted exactly; the edit bound defaults to about one per
@@ -151,7 +151,7 @@ fn wobble_axes(t: Token) -> Symbol {
 }
 
 /// Angle (rad, ≈ 7°) a plain stroke must turn about one axis for that turn to count as a
-/// wobble of it ([`slow_wobble_axis`]).
+/// wobble of it ([`intent_symbols`]).
 pub const SLOW_WOBBLE_RAD: f64 = 0.12;
 /// Share of a plain stroke's turning that one axis needs to be its wobble axis.
 pub const SLOW_WOBBLE_SHARE: f64 = 0.6;

@@ -5,7 +5,7 @@
 //! - [`regex`]: pattern sources → Glushkov automata → device records.
 //! - [`library`] / [`effort_model`]: LIB.json and EFFORT.json, and their device blobs.
 //! - [`dtw`] + [`learn`] + [`separate`]: `figurine learn`.
-//! - [`effort_train`] + [`report`] (+ [`font`]): `figurine train-effort`.
+//! - [`effort_train`] + [`report`] (+ `font`): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
 //! - [`eval`] (+ [`eval_pairs`]): `figurine eval`.
 

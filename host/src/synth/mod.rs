@@ -13,7 +13,7 @@
 //! Data flow, one file per stage: [`rng`] (seeded streams) → [`knobs`] (nuisance draw) →
 //! [`effort`] + [`mod@gesture`] (strokes) → [`trajectory`] (clean pose over time) → [`sampling`]
 //! (sample instants, quaternion sign) + [`noise`] (sensor, hand, optional glitches) →
-//! [`mod@sequence`] (labelled doodles and sets) → [`cli`] / [`plot`] (+ [`font`] for captions).
+//! [`mod@sequence`] (labelled doodles and sets) → [`cli`] / [`plot`] (+ `font` for captions).
 //!
 //! How the effort classes show in the data (what a recognizer can learn): Time in stroke
 //! durations (sustained ≈ 3× sudden) and peak speeds (≥ 1.9× at equal weight); Weight in
