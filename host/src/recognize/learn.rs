@@ -919,15 +919,17 @@ mod tests {
         assert_eq!(out, want);
     }
 
+    /// Three generated learning examples of `action` (seed `seed`).
+    fn example_logs(action: Action, seed: u64) -> Vec<PoseLog> {
+        synth::examples(seed, &Knobs::default(), action, 3, None)
+            .into_iter()
+            .map(|d| d.log)
+            .collect()
+    }
+
     #[test]
     fn a_walk_bobs_where_a_run_skims_and_a_sidestep_goes_sideways() {
-        let shape = |action: Action, seed: u64| {
-            let logs: Vec<PoseLog> = synth::examples(seed, &Knobs::default(), action, 3, None)
-                .into_iter()
-                .map(|d| d.log)
-                .collect();
-            mean_shape(&logs).unwrap()
-        };
+        let shape = |action: Action, seed: u64| mean_shape(&example_logs(action, seed)).unwrap();
         for seed in [1, 2, 3] {
             let (walk, run, side) = (
                 shape(Action::Walk, seed),
@@ -952,13 +954,7 @@ mod tests {
 
     #[test]
     fn a_kick_flicked_flat_or_high_spreads_its_shape_more_than_a_walk() {
-        let spread = |action: Action, seed: u64| {
-            let logs: Vec<PoseLog> = synth::examples(seed, &Knobs::default(), action, 3, None)
-                .into_iter()
-                .map(|d| d.log)
-                .collect();
-            shape_spread(&logs).unwrap()
-        };
+        let spread = |action: Action, seed: u64| shape_spread(&example_logs(action, seed)).unwrap();
         // Over a few example sets: a kick's flick rises 0.3–1.4× as far as it goes forward.
         let kick: f32 = (1..=4).map(|s| spread(Action::Kick, s)).sum();
         let walk: f32 = (1..=4).map(|s| spread(Action::Walk, s)).sum();
