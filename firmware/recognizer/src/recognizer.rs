@@ -229,14 +229,7 @@ impl<'lib> Recognizer<'lib> {
                     let found = match self.nearest {
                         Some((r, n)) if r == run => n,
                         _ => {
-                            let hist = self.front.history();
-                            let n = nearest_action(
-                                &self.library,
-                                hist,
-                                self.phrase_floor.0,
-                                self.phrase_floor.1,
-                                run.wrapping_sub(1),
-                            );
+                            let n = self.nearest_to(run.wrapping_sub(1));
                             self.nearest = Some((run, n));
                             n
                         }
@@ -361,16 +354,23 @@ impl<'lib> Recognizer<'lib> {
             } else {
                 newest
             };
-            let (floor, bounds) = self.phrase_floor;
             if let Some(Nearest {
                 candidate: Some(c),
                 open: false,
-            }) = nearest_action(&self.library, hist, floor, bounds, last)
+            }) = self.nearest_to(last)
             {
                 self.commit(c, &mut emit);
             }
         }
         self.held = None;
+    }
+
+    /// [`nearest_action`] for the phrase ending at run `last`, from where a phrase may begin.
+    // Two call sites, once per pause and at the end: inlined, as the call was (flash).
+    #[inline(always)]
+    fn nearest_to(&self, last: u32) -> Option<Nearest> {
+        let (floor, bounds) = self.phrase_floor;
+        nearest_action(&self.library, self.front.history(), floor, bounds, last)
     }
 
     /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.

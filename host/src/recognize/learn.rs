@@ -95,12 +95,18 @@ pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
     gesture_accum(log).map(|acc| acc.shape())
 }
 
-/// How far the examples' shapes lie from their mean ([`mean_shape`]): the largest distance
-/// of one from it. None when none moved.
-pub fn shape_spread(logs: &[PoseLog]) -> Option<f32> {
-    let mean = mean_shape(logs)?;
-    logs.iter()
-        .filter_map(motion_shape)
+/// The motion shapes of the examples that moved ([`motion_shape`]), read once for
+/// [`mean_shape`] and [`shape_spread`].
+pub fn example_shapes(logs: &[PoseLog]) -> Vec<[f32; 3]> {
+    logs.iter().filter_map(motion_shape).collect()
+}
+
+/// How far the shapes lie from their mean ([`mean_shape`]): the largest distance of one from
+/// it. None without shapes.
+pub fn shape_spread(shapes: &[[f32; 3]]) -> Option<f32> {
+    let mean = mean_shape(shapes)?;
+    shapes
+        .iter()
         .map(|s| {
             let d2: f32 = s.iter().zip(&mean).map(|(a, b)| (a - b) * (a - b)).sum();
             d2.sqrt()
@@ -108,9 +114,8 @@ pub fn shape_spread(logs: &[PoseLog]) -> Option<f32> {
         .reduce(f32::max)
 }
 
-/// The mean motion shape of the examples ([`motion_shape`]); None when none moved.
-pub fn mean_shape(logs: &[PoseLog]) -> Option<[f32; 3]> {
-    let shapes: Vec<[f32; 3]> = logs.iter().filter_map(motion_shape).collect();
+/// The mean of motion shapes ([`example_shapes`]); None without shapes.
+pub fn mean_shape(shapes: &[[f32; 3]]) -> Option<[f32; 3]> {
     if shapes.is_empty() {
         return None;
     }
@@ -167,9 +172,7 @@ fn slow_wobble_axis(acc: &Accum, t: Token) -> Option<u16> {
         return None;
     }
     let dt = f64::from(figurine_recognizer::intake::TICK_S);
-    let a: Vec<f64> = (0..3)
-        .map(|i| dt * f64::from(acc.sum[ANGVEL + i]))
-        .collect();
+    let a: [f64; 3] = core::array::from_fn(|i| dt * f64::from(acc.sum[ANGVEL + i]));
     let total: f64 = a.iter().sum();
     let (axis, &most) = a.iter().enumerate().max_by(|x, y| x.1.total_cmp(y.1))?;
     (most >= SLOW_WOBBLE_RAD && most >= SLOW_WOBBLE_SHARE * total).then_some(axis as u16)
@@ -791,6 +794,7 @@ pub fn learn_action(
         learn_regex(&all)?
     };
     let c = re.compile()?;
+    let shapes = example_shapes(logs);
     let examples: Vec<String> = raw_examples
         .iter()
         .map(|s| tokens_to_string(&tokens_only(s)))
@@ -801,8 +805,8 @@ pub fn learn_action(
         Some(max_edits.unwrap_or_else(|| default_edits(c.min_len()))),
         examples,
     )?
-    .with_shape(mean_shape(logs))
-    .with_shape_spread(shape_spread(logs));
+    .with_shape(mean_shape(&shapes))
+    .with_shape_spread(shape_spread(&shapes));
     Ok(entry)
 }
 
@@ -929,7 +933,9 @@ mod tests {
 
     #[test]
     fn a_walk_bobs_where_a_run_skims_and_a_sidestep_goes_sideways() {
-        let shape = |action: Action, seed: u64| mean_shape(&example_logs(action, seed)).unwrap();
+        let shape = |action: Action, seed: u64| {
+            mean_shape(&example_shapes(&example_logs(action, seed))).unwrap()
+        };
         for seed in [1, 2, 3] {
             let (walk, run, side) = (
                 shape(Action::Walk, seed),
@@ -954,12 +960,21 @@ mod tests {
 
     #[test]
     fn a_kick_flicked_flat_or_high_spreads_its_shape_more_than_a_walk() {
-        let spread = |action: Action, seed: u64| shape_spread(&example_logs(action, seed)).unwrap();
+        let spread = |action: Action, seed: u64| {
+            shape_spread(&example_shapes(&example_logs(action, seed))).unwrap()
+        };
         // Over a few example sets: a kick's flick rises 0.3–1.4× as far as it goes forward.
         let kick: f32 = (1..=4).map(|s| spread(Action::Kick, s)).sum();
         let walk: f32 = (1..=4).map(|s| spread(Action::Walk, s)).sum();
         assert!(kick > walk, "kick {kick} walk {walk}");
         assert!(walk >= 0.0);
+    }
+
+    /// Whether `re` accepts the token string `tokens` (names separated by spaces) exactly.
+    fn accepts(re: &Regex, tokens: &str) -> bool {
+        re.compile()
+            .unwrap()
+            .accepts(&parse_tokens(tokens).unwrap())
     }
 
     fn seq(s: &str) -> Tokenized {
@@ -1014,10 +1029,8 @@ mod tests {
             seq("lu:0.4 lu:0.4"),
         ];
         let re = learn_regex(&seqs).unwrap();
-        let c = re.compile().unwrap();
-        let t = |s: &str| parse_token(s).unwrap();
-        assert!(c.accepts(&[t("lu"), t("lu")]), "{}", re.to_source());
-        assert!(c.accepts(&[t("lu"), t("l"), t("ld")]), "{}", re.to_source());
+        assert!(accepts(&re, "lu lu"), "{}", re.to_source());
+        assert!(accepts(&re, "lu l ld"), "{}", re.to_source());
         // A long performance lacking a column still only costs an edit: the column stays.
         let seqs = vec![
             seq("lu:0.3 l:0.3 ld:0.3 u:0.3"),
@@ -1166,15 +1179,9 @@ mod tests {
             seq(".Yn:0.4"),
         ];
         let re = learn_regex(&seqs).unwrap();
-        let c = re.compile().unwrap();
-        assert!(c.cyclic, "{}", re.to_source());
-        let t = |s: &str| parse_token(s).unwrap();
+        assert!(re.compile().unwrap().cyclic, "{}", re.to_source());
         // A turn in two twists, with its settling between them, is one match.
-        assert!(
-            c.accepts(&[t(".Yn"), t("u"), t(".Yn")]),
-            "{}",
-            re.to_source()
-        );
+        assert!(accepts(&re, ".Yn u .Yn"), "{}", re.to_source());
         // A two-stroke action does not become cyclic by this.
         let seqs = vec![seq("b:0.3 f:0.3"), seq("b:0.2 f:0.4")];
         let re = learn_regex(&seqs).unwrap();
