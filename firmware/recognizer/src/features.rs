@@ -183,20 +183,65 @@ pub fn motion_shape(sums: [f32; 3], speed: f32, n: u32) -> [f32; 3] {
     sums.map(|s| s / speed)
 }
 
+/// Dimensions of a [`Shape`].
+pub const SHAPE_DIMS: usize = 5;
+
+/// How a span of motion moved, whatever its size, speed and place: mean |velocity| along the
+/// object's left, up and front axes, each as a share of the mean speed ([`motion_shape`]);
+/// `ln(1 + angle turned)` (rad, the three axes' turning combined: a kick's lean, a throw's
+/// swing and a punch's twist differ in it where their strokes do not); and the share of its
+/// time spent still (a crouch is held low, a jump is not).
+pub type Shape = [f32; SHAPE_DIMS];
+
+/// Sums over a span of token runs from which its [`Shape`] follows.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ShapeSums {
+    lin: [f32; 3],
+    turn: [f32; 3],
+    speed: f32,
+    ticks: u32,
+    still: u32,
+}
+
+impl ShapeSums {
+    /// Nothing summed.
+    pub const fn new() -> Self {
+        ShapeSums {
+            lin: [0.0; 3],
+            turn: [0.0; 3],
+            speed: 0.0,
+            ticks: 0,
+            still: 0,
+        }
+    }
+
+    /// Adds a run's sums; `still`: the run is STILL.
+    pub fn add(&mut self, acc: &Accum, still: bool) {
+        for k in 0..3 {
+            self.lin[k] += acc.sum[k];
+            self.turn[k] += acc.sum[ANGVEL + k];
+        }
+        self.speed += acc.sum[SPEED];
+        self.ticks = self.ticks.saturating_add(acc.n);
+        if still {
+            self.still = self.still.saturating_add(acc.n);
+        }
+    }
+
+    /// The shape of what was added.
+    pub fn shape(&self) -> Shape {
+        let [l, u, f] = motion_shape(self.lin, self.speed, self.ticks);
+        let angle = TICK_S * fmath::norm3(self.turn);
+        let still = self.still as f32 / fmath::max(self.ticks as f32, 1.0);
+        [l, u, f, fmath::ln(1.0 + angle), still]
+    }
+}
+
 impl Accum {
     /// Σ over the ticks of |ω| about the three object axes, rad/s (× [`TICK_S`]: the angle
     /// turned, rad, counting each axis).
     pub fn turn_sum(&self) -> f32 {
         self.sum[ANGVEL] + self.sum[ANGVEL + 1] + self.sum[ANGVEL + 2]
-    }
-
-    /// The motion shape of these ticks ([`motion_shape`]).
-    pub fn shape(&self) -> [f32; 3] {
-        motion_shape(
-            [self.sum[0], self.sum[1], self.sum[2]],
-            self.sum[SPEED],
-            self.n,
-        )
     }
 }
 
@@ -287,6 +332,38 @@ impl FeatureExtractor {
 mod tests {
     use super::*;
     use crate::intake::Tick;
+
+    #[test]
+    fn a_shape_has_the_shares_the_turn_and_the_time_held() {
+        // 30 ticks moving up-and-forward at 0.6 / 0.8 m/s while pitching at 2 rad/s, then
+        // 10 ticks held still.
+        let mut moving = Accum::new();
+        let mut q = [0.0; QUANTITIES];
+        q[1] = 0.6;
+        q[2] = 0.8;
+        q[ANGVEL] = 2.0;
+        q[SPEED] = 1.0;
+        for _ in 0..30 {
+            moving.add(&q);
+        }
+        let mut held = Accum::new();
+        for _ in 0..10 {
+            held.add(&[0.0; QUANTITIES]);
+        }
+        let mut sums = ShapeSums::new();
+        sums.add(&moving, false);
+        sums.add(&held, true);
+        let s = sums.shape();
+        let want = [0.0, 0.6, 0.8, libm::logf(1.0 + 30.0 * TICK_S * 2.0), 0.25];
+        for (got, want) in s.iter().zip(want) {
+            assert!((got - want).abs() < 1e-5, "{s:?}");
+        }
+        // Nothing added: no shares of a speed that is not there (NaN: no evidence, which
+        // `segment::shape_penalty` charges nothing for), no turn, nothing held.
+        let empty = ShapeSums::new().shape();
+        assert!(empty[..3].iter().all(|x| x.is_nan()), "{empty:?}");
+        assert_eq!(empty[3..], [0.0, 0.0]);
+    }
 
     fn kin(v: [f32; 3], a: [f32; 3], j: [f32; 3]) -> Kinematics {
         Kinematics {

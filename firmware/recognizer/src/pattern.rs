@@ -8,8 +8,8 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (2; version 1, the same without the shape table, is
-//!         still read)
+//! 0   4   magic "FGL" + version byte (3; version 2, whose shape table has only the first 4
+//!         bytes of each entry, and version 1, without the table, are still read)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
 //! 5   3   reserved, zero
 //! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
@@ -24,17 +24,22 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then (version 2) the shape table, 4 bytes per action in record order:
-//! +0  3   the action's motion shape: mean |velocity| along left, up, front (object frame)
-//!         over its examples, each as a share of the mean speed, × 255 rounded
-//! +3  1   0 = shape unknown (the three bytes are zero); else shape known (learnt from
+//! then the shape table, 6 bytes per action in record order (the mean of its examples'
+//! shapes, `features::Shape`):
+//! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
+//!         speed, × 255 rounded
+//! +3  1   0 = shape unknown (all six bytes are zero); else shape known (learnt from
 //!         examples), and 1 + 254 × how far the examples' shapes lay from it (the largest
-//!         distance, rounded; 1 = the examples agree, or a library from before the spread)
+//!         `segment::shape_distance`, rounded; 1 = the examples agree, or a library from
+//!         before the spread)
+//! +4  1   ln(1 + angle turned, rad) × 255 / SHAPE_TURN_MAX, rounded
+//! +5  1   share of the time spent still × 255, rounded
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
 //! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
 
+use crate::features::Shape;
 use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
 use crate::Error;
 
@@ -45,16 +50,20 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 2;
+pub const LIBRARY_VERSION: u8 = 3;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 4;
+pub const SHAPE_BYTES: usize = 6;
+/// Bytes per action in a version 2 shape table (no turn, no still share).
+const SHAPE_BYTES_V2: usize = 4;
+/// The largest `ln(1 + angle turned)` the shape table holds (about 8.5 turns).
+pub const SHAPE_TURN_MAX: f32 = 4.0;
 /// Library blob header size, bytes.
 pub const LIBRARY_HEADER: usize = 8;
 /// Size of one action record with `n` positions, bytes.
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (11,784).
+/// Largest valid library blob, bytes (11,848).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -208,6 +217,8 @@ pub struct Library<'a> {
     offsets: [u16; MAX_ACTIONS],
     /// Offset of the shape table (0: none, a version 1 blob).
     shapes: u16,
+    /// Bytes per entry of the shape table.
+    shape_bytes: u8,
 }
 
 impl<'a> Library<'a> {
@@ -218,6 +229,7 @@ impl<'a> Library<'a> {
             n: 0,
             offsets: [0; MAX_ACTIONS],
             shapes: 0,
+            shape_bytes: 0,
         }
     }
 
@@ -231,7 +243,7 @@ impl<'a> Library<'a> {
             return Err(Error::BadMagic);
         }
         let version = head[3];
-        if version != 1 && version != LIBRARY_VERSION {
+        if !(1..=LIBRARY_VERSION).contains(&version) {
             return Err(Error::Version(version));
         }
         let n = usize::from(head[4]);
@@ -256,18 +268,21 @@ impl<'a> Library<'a> {
             at += record_size(np);
         }
         let mut shapes = 0;
-        if version == LIBRARY_VERSION {
-            let table = bytes
-                .get(at..at + SHAPE_BYTES * n)
-                .ok_or(Error::Truncated)?;
-            for s in table.chunks_exact(SHAPE_BYTES) {
-                match s {
-                    [_, _, _, 1..=255] | [0, 0, 0, 0] => {}
-                    _ => return Err(Error::Invalid("shape table")),
+        let stride = match version {
+            1 => 0,
+            2 => SHAPE_BYTES_V2,
+            _ => SHAPE_BYTES,
+        };
+        if stride > 0 {
+            let table = bytes.get(at..at + stride * n).ok_or(Error::Truncated)?;
+            for s in table.chunks_exact(stride) {
+                // Known (flag ≠ 0), or unknown and all zero.
+                if s.get(3) == Some(&0) && s.iter().any(|&b| b != 0) {
+                    return Err(Error::Invalid("shape table"));
                 }
             }
             shapes = at as u16;
-            at += SHAPE_BYTES * n;
+            at += stride * n;
         }
         if at != bytes.len() {
             return Err(Error::Invalid("trailing bytes"));
@@ -277,18 +292,25 @@ impl<'a> Library<'a> {
             n,
             offsets,
             shapes,
+            shape_bytes: stride as u8,
         })
     }
 
-    /// The motion shape of action `i` — mean |velocity| along the object's left, up and
-    /// front axes, each as a share of the mean speed — when it was learnt with one.
-    pub fn shape(&self, i: usize) -> Option<[f32; 3]> {
-        if self.shapes == 0 || i >= self.n {
+    /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2
+    /// library's shapes lack two dimensions and are not used).
+    pub fn shape(&self, i: usize) -> Option<Shape> {
+        if usize::from(self.shape_bytes) != SHAPE_BYTES || i >= self.n {
             return None;
         }
         let at = usize::from(self.shapes) + SHAPE_BYTES * i;
         match *self.bytes.get(at..at + SHAPE_BYTES)? {
-            [l, u, f, 1..=255] => Some([l, u, f].map(|b| f32::from(b) / 255.0)),
+            [l, u, f, 1..=255, t, s] => Some([
+                f32::from(l) / 255.0,
+                f32::from(u) / 255.0,
+                f32::from(f) / 255.0,
+                f32::from(t) * (SHAPE_TURN_MAX / 255.0),
+                f32::from(s) / 255.0,
+            ]),
             _ => None,
         }
     }
@@ -299,7 +321,7 @@ impl<'a> Library<'a> {
         if self.shapes == 0 || i >= self.n {
             return 0.0;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i + 3;
+        let at = usize::from(self.shapes) + usize::from(self.shape_bytes) * i + 3;
         match self.bytes.get(at) {
             Some(&k) if k > 1 => f32::from(k - 1) / 254.0,
             _ => 0.0,
@@ -474,13 +496,13 @@ pub(crate) mod tests {
         out
     }
 
-    /// `blob` (version 1) as version 2 with a shape table (`None`: unknown).
-    pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 3]>]) -> Vec<u8> {
+    /// `blob` (version 1) as the current version with a shape table (`None`: unknown).
+    pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 5]>]) -> Vec<u8> {
         let mut out = blob.to_vec();
         out[3] = LIBRARY_VERSION;
         for s in shapes {
             match s {
-                Some([l, u, f]) => out.extend([*l, *u, *f, 1]),
+                Some([l, u, f, t, st]) => out.extend([*l, *u, *f, 1, *t, *st]),
                 None => out.extend([0; SHAPE_BYTES]),
             }
         }
@@ -488,40 +510,51 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn version_2_carries_a_shape_per_action_and_version_1_still_loads() {
+    fn the_shape_table_carries_a_shape_per_action_and_older_versions_still_load() {
         let v1 = seq_library(&[(&["u", "d"], 0), (&["f", "b"], 0)]);
         let old = Library::from_bytes(&v1).unwrap();
         assert_eq!((old.len(), old.shape(0)), (2, None));
-        let v2 = with_shapes(&v1, &[Some([0, 255, 51]), None]);
-        let lib = Library::from_bytes(&v2).unwrap();
-        assert_eq!(lib.shape(0), Some([0.0, 1.0, 0.2]));
+        let v3 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255]), None]);
+        let lib = Library::from_bytes(&v3).unwrap();
+        let near = |a: Option<Shape>, b: [f32; 5]| {
+            a.is_some_and(|a| (0..5).all(|k| (a[k] - b[k]).abs() < 1e-6))
+        };
+        assert!(near(lib.shape(0), [0.0, 1.0, 0.2, 0.8, 1.0]));
         assert_eq!(lib.shape(1), None);
         assert_eq!(lib.shape(2), None);
         assert_eq!(lib.pattern(1).unwrap().positions(), 2);
         assert_eq!((lib.shape_spread(0), lib.shape_spread(1)), (0.0, 0.0));
         // The flag byte also carries how far the examples' shapes spread: 1 + 51 → 51 / 254.
-        let mut spread = v2.clone();
-        let flag = spread.len() - SHAPE_BYTES - 1;
+        let mut spread = v3.clone();
+        let flag = spread.len() - 2 * SHAPE_BYTES + 3;
         spread[flag] = 1 + 51;
         let lib = Library::from_bytes(&spread).unwrap();
-        assert_eq!(lib.shape(0), Some([0.0, 1.0, 0.2]));
+        assert!(near(lib.shape(0), [0.0, 1.0, 0.2, 0.8, 1.0]));
         assert_eq!(lib.shape_spread(0), 51.0 / 254.0);
         // A missing or partial table, a known shape without its flag, stray bytes after an
         // unknown shape.
         assert_eq!(
-            Library::from_bytes(&v2[..v2.len() - 1]).err(),
+            Library::from_bytes(&v3[..v3.len() - 1]).err(),
             Some(Error::Truncated)
         );
-        let mut bad = v2.clone();
+        let mut bad = v3.clone();
         bad[flag] = 0;
         assert!(Library::from_bytes(&bad).is_err());
-        let mut bad = v2.clone();
+        let mut bad = v3.clone();
         let last = bad.len() - 2;
         bad[last] = 7;
         assert!(Library::from_bytes(&bad).is_err());
-        let mut v3 = v2.clone();
-        v3[3] = 3;
-        assert_eq!(Library::from_bytes(&v3).err(), Some(Error::Version(3)));
+        // Version 2: four bytes per entry; its patterns load, its shapes (which lack the
+        // turn and the still share) are not used.
+        let mut v2 = v1.clone();
+        v2[3] = 2;
+        v2.extend([0, 255, 51, 52, 0, 0, 0, 0]);
+        let lib = Library::from_bytes(&v2).unwrap();
+        assert_eq!((lib.len(), lib.shape(0)), (2, None));
+        assert_eq!(lib.pattern(1).unwrap().positions(), 2);
+        let mut v4 = v3.clone();
+        v4[3] = 4;
+        assert_eq!(Library::from_bytes(&v4).err(), Some(Error::Version(4)));
     }
 
     #[test]

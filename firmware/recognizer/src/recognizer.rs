@@ -10,7 +10,7 @@
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::features::{motion_shape, segment_features, SPEED};
+use crate::features::{segment_features, Shape, ShapeSums};
 use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
@@ -18,8 +18,8 @@ use crate::intake::{IntakeCounters, Sample};
 use crate::nearest::{nearest_action, Nearest};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, shape_penalty, Candidate, Decider, Decision, CONTINUE_US, GAPPED_HOLD_US,
-    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, CONTINUE_US,
+    GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -478,7 +478,7 @@ impl<'lib> Recognizer<'lib> {
                 min_len: p.min_len().min(255) as u8,
                 positions: p.positions().min(255) as u8,
                 cyclic: p.cyclic(),
-                shape: shape_of(&self.library, a, hist, start, end),
+                shape: shape_cost(shape_of(&self.library, a, hist, start, end), j + 1),
             };
             if best.is_none_or(|b| c.beats(&b)) {
                 best = Some(c);
@@ -635,26 +635,20 @@ fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u3
     }
 }
 
-/// The motion shape of runs `start..=end`: mean |velocity| along the object's left, up and
-/// front axes, each as a share of the mean speed (see [`shape_penalty`]).
-fn observed_shape(hist: &History, start: u32, end: u32) -> [f32; 3] {
-    let mut sum = [0.0f32; 3];
-    let (mut speed, mut n) = (0.0f32, 0u32);
+/// The motion shape of runs `start..=end` ([`Shape`]), the holds between them included.
+fn observed_shape(hist: &History, start: u32, end: u32) -> Shape {
+    let mut sums = ShapeSums::new();
     let mut i = start;
     for _ in 0..HISTORY_RUNS {
         if let Some(r) = hist.get(i) {
-            for (s, x) in sum.iter_mut().zip(r.acc.sum.iter()) {
-                *s += x;
-            }
-            speed += r.acc.sum.get(SPEED).copied().unwrap_or(0.0);
-            n = n.saturating_add(r.acc.n);
+            sums.add(&r.acc, r.token == STILL);
         }
         if i == end {
             break;
         }
         i = i.wrapping_add(1);
     }
-    motion_shape(sum, speed, n)
+    sums.shape()
 }
 
 #[cfg(test)]
@@ -715,12 +709,18 @@ mod tests {
         };
         // Without shapes the tie goes to the lower index.
         assert_eq!(actions(&v1), [0]);
-        // Shares of speed (× 255): left, up, front. The hop is the bob's, whichever its index.
-        let skim = Some([0, 50, 250]);
-        let bob = Some([0, 150, 200]);
+        // Shares of speed (× 255): left, up, front; then the turn and the still share, none
+        // here. The hop is the bob's, whichever its index.
+        let skim = Some([0, 50, 250, 0, 0]);
+        let bob = Some([0, 150, 200, 0, 0]);
         let with = crate::pattern::tests::with_shapes;
         assert_eq!(actions(&with(&v1, &[skim, bob])), [1]);
         assert_eq!(actions(&with(&v1, &[bob, skim])), [0]);
+        // Two bobs, one of which turns (ln(1 + angle) = 2 × 100 / 255 ≈ 0.8, a turn of about
+        // 1.2 rad) and holds a third of its time: the hop, which does neither, is the other's.
+        let twisting = Some([0, 150, 200, 100, 85]);
+        assert_eq!(actions(&with(&v1, &[twisting, bob])), [1]);
+        assert_eq!(actions(&with(&v1, &[bob, twisting])), [0]);
     }
 
     #[test]

@@ -6,9 +6,9 @@
 //! more). A pending candidate is replaced by an overlapping one of higher merit
 //! `4·length − 3·cost − shape`, the cost in half-edits ([`crate::alignment`]: a token that
 //! differs from the pattern only in its rotation, or by 45° in its direction, costs half an
-//! edit), the shape up to one token when the matched motion moves unlike the action's
-//! examples did ([`shape_penalty`]) — near-ties go to the longest action, as in seed 000
-//! §7.5, and an action that keeps
+//! edit), the shape up to one token per [`SHAPE_TOKENS`] tokens when the matched motion moves
+//! unlike the action's examples did ([`shape_cost`]) — near-ties go to the longest action, as
+//! in seed 000 §7.5, and an action that keeps
 //! extending (a walk of several hops) grows instead of being cut. The pending candidate is
 //! committed when
 //! - a candidate appears that starts after it (the next action has begun),
@@ -26,6 +26,7 @@
 //! has paused after it.
 
 use crate::alignment::FULL;
+use crate::features::Shape;
 use crate::fmath;
 
 /// Quarter tokens of merit per squared share of speed by which a match's motion shape
@@ -35,24 +36,46 @@ pub const SHAPE_WEIGHT: f32 = 50.0;
 /// decide, the shape only tips near-ties.
 pub const SHAPE_CAP: i16 = 4;
 
-/// The merit (quarter tokens) a match loses when its motion shape `observed` — mean
-/// |velocity| along the object's left, up and front axes as shares of the mean speed — is
-/// unlike its action's `expected` one: [`SHAPE_WEIGHT`] × the squared distance beyond
+/// Weight of each [`Shape`] dimension in [`shape_distance`]: the shares of speed as they are;
+/// the log angle turned and the still share scaled so that what tells actions apart in them
+/// (a throw turns about twice as far as a kick; a crouch spends half its time held, a jump a
+/// fifth) weighs about as much as a walk's bob against a run's skim does in the shares.
+pub const SHAPE_SCALE: Shape = [1.0, 1.0, 1.0, 0.5, 0.5];
+
+/// Weighted distance between two shapes ([`SHAPE_SCALE`]); NaN when either has a NaN.
+pub fn shape_distance(a: &Shape, b: &Shape) -> f32 {
+    let mut d2 = 0.0;
+    for ((x, y), w) in a.iter().zip(b.iter()).zip(SHAPE_SCALE.iter()) {
+        d2 += w * w * (x - y) * (x - y);
+    }
+    fmath::sqrt(d2)
+}
+
+/// The merit (quarter tokens) a match loses when its motion shape `observed` is unlike its
+/// action's `expected` one: [`SHAPE_WEIGHT`] × the squared [`shape_distance`] beyond
 /// `spread` (how far the action's own examples lay from `expected`), at most [`SHAPE_CAP`].
 /// Tokens only know which way each stroke went, to 45°; the shape keeps how much: a walk's
 /// hops bob, a run's strides skim, though both are written `uf f df`. Where the examples
 /// themselves varied (a kick flicked flat or high), so may a performance, at no cost.
-pub fn shape_penalty(expected: [f32; 3], spread: f32, observed: [f32; 3]) -> i16 {
-    let mut d2 = 0.0;
-    for (e, o) in expected.iter().zip(observed.iter()) {
-        d2 += (e - o) * (e - o);
-    }
-    if !fmath::is_finite(d2) || d2 <= spread * spread {
+pub fn shape_penalty(expected: Shape, spread: f32, observed: Shape) -> i16 {
+    let d = shape_distance(&expected, &observed);
+    if !fmath::is_finite(d) || d <= spread {
         // A degenerate shape (no evidence either way), or one as close as the examples'.
         return 0;
     }
-    let beyond = fmath::sqrt(d2) - spread;
+    let beyond = d - spread;
     fmath::min(SHAPE_WEIGHT * beyond * beyond, f32::from(SHAPE_CAP)) as i16
+}
+
+/// Tokens of a match over which a shape unlike its action's costs up to [`SHAPE_CAP`] once
+/// more. The evidence grows with the match: a dozen strides that all skim are no walk, however
+/// well their tokens fit one, while the shape of a few tokens only tips a near-tie.
+pub const SHAPE_TOKENS: usize = 2;
+
+/// The merit (quarter tokens) a match over `len` tokens loses for a shape `penalty`
+/// ([`shape_penalty`]): the penalty once per [`SHAPE_TOKENS`] tokens, at least once.
+pub fn shape_cost(penalty: i16, len: usize) -> i16 {
+    penalty.saturating_mul((len / SHAPE_TOKENS).clamp(1, 255) as i16)
 }
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
@@ -121,8 +144,8 @@ pub struct Candidate {
     pub positions: u8,
     /// The pattern can repeat as a whole (a cyclic action: walk, wave …).
     pub cyclic: bool,
-    /// How far the matched motion's shape is from its action's ([`shape_penalty`]),
-    /// quarter tokens (0 ..= [`SHAPE_CAP`]), taken off its merit.
+    /// How far the matched motion's shape is from its action's ([`shape_cost`]), quarter
+    /// tokens, taken off its merit.
     pub shape: i16,
 }
 
@@ -134,7 +157,7 @@ impl Candidate {
 
     /// Ranking score, in quarter tokens: longer is better, each edit costs 1.5 tokens
     /// (a rotation-only disagreement half of that), a shape unlike the action's up to one
-    /// token.
+    /// token per [`SHAPE_TOKENS`].
     pub fn merit(&self) -> i32 {
         Self::merit_of(usize::from(self.len), self.cost) - i32::from(self.shape)
     }
@@ -283,20 +306,29 @@ mod tests {
 
     #[test]
     fn a_shape_unlike_the_actions_costs_up_to_one_token() {
-        let walk = [0.1, 0.55, 0.75];
+        let walk = [0.1, 0.55, 0.75, 0.3, 0.2];
+        let like = |l: f32, u: f32, f: f32| [l, u, f, 0.3, 0.2];
         assert_eq!(shape_penalty(walk, 0.0, walk), 0);
         // A run's flatter strides: 0.3 less up, 0.1 more front → 50 × 0.1 = 5 → capped at 4.
-        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.25, 0.85]), SHAPE_CAP);
+        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.25, 0.85)), SHAPE_CAP);
         // A little off: 50 × 0.04² ≈ 0.08 → nothing.
-        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.51, 0.75]), 0);
+        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.51, 0.75)), 0);
         // 50 × 0.2² = 2 quarter tokens.
-        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.35, 0.75]), 2);
-        assert_eq!(shape_penalty(walk, 0.0, [f32::NAN, 0.5, 0.7]), 0);
+        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.35, 0.75)), 2);
+        assert_eq!(shape_penalty(walk, 0.0, like(f32::NAN, 0.5, 0.7)), 0);
+        // The same strokes, turning much further (a throw's swing for a kick's lean): ln-angle
+        // 0.8 apart, weighed 0.5 → 50 × 0.4² = 8 → capped; held 0.4 longer (weighed 0.5) →
+        // 50 × 0.2² = 2.
+        assert_eq!(
+            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 1.1, 0.2]),
+            SHAPE_CAP
+        );
+        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.6]), 2);
         // Where the examples lay up to 0.1 away, only what lies beyond counts: 50 × 0.1² = 0.5
         // → nothing; 50 × 0.2² = 2.
-        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.45, 0.75]), 0);
-        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.35, 0.75]), 0);
-        assert_eq!(shape_penalty(walk, 0.1, [0.1, 0.25, 0.75]), 2);
+        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.45, 0.75)), 0);
+        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.35, 0.75)), 0);
+        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.25, 0.75)), 2);
         // Taken off the merit: an exact tie goes to the matching shape.
         let a = Candidate {
             shape: 0,
@@ -308,6 +340,13 @@ mod tests {
         };
         assert!(a.beats(&b) && !b.beats(&a));
         assert_eq!(b.merit(), a.merit() - 2);
+        // Over a longer match the same unlikeness counts once per two tokens.
+        assert_eq!(shape_cost(2, 1), 2);
+        assert_eq!(shape_cost(2, 3), 2);
+        assert_eq!(shape_cost(2, 4), 4);
+        assert_eq!(shape_cost(SHAPE_CAP, 12), 6 * SHAPE_CAP);
+        assert_eq!(shape_cost(0, 12), 0);
+        assert_eq!(shape_cost(SHAPE_CAP, usize::MAX), 255 * SHAPE_CAP);
     }
 
     #[test]

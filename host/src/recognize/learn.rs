@@ -31,9 +31,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
-use figurine_recognizer::features::{Accum, ANGVEL, SPEED};
+use figurine_recognizer::features::{Accum, Shape, ShapeSums, ANGVEL, SPEED};
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
-use figurine_recognizer::segment::edits_fit;
+use figurine_recognizer::segment::{edits_fit, shape_distance};
 use figurine_recognizer::token::{
     mirror_token, symbol_matches, token_from_signs, token_signs, Symbol, Token, ANY_LIN, ANY_ROT,
     NONE_BIN, STILL, TURN,
@@ -41,7 +41,7 @@ use figurine_recognizer::token::{
 use figurine_recognizer::Library;
 
 use super::dtw;
-use super::feed::{gesture_accum, gesture_runs, log_runs, log_samples};
+use super::feed::{gesture_runs, log_runs, log_samples};
 use super::library::{parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
 use super::regex::{default_edits, Regex};
 use crate::poselog::PoseLog;
@@ -88,39 +88,48 @@ pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
         .collect()
 }
 
-/// The motion shape of a one-performance log's gesture: mean |velocity| along the figurine's
-/// left, up and front axes, each as a share of the mean speed — what the device measures over
-/// a match (`figurine_recognizer::segment::shape_penalty`). None without motion.
-pub fn motion_shape(log: &PoseLog) -> Option<[f32; 3]> {
-    gesture_accum(log).map(|acc| acc.shape())
+/// The motion shape of a one-performance log's gesture, from its first to its last motion
+/// (`figurine_recognizer::features::Shape`) — what the device measures over a match
+/// (`figurine_recognizer::segment::shape_penalty`). None without motion.
+pub fn motion_shape(log: &PoseLog) -> Option<Shape> {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let g = gesture_runs(&runs);
+    if g.is_empty() {
+        return None;
+    }
+    let mut sums = ShapeSums::new();
+    for r in g {
+        sums.add(&r.acc, r.token == STILL);
+    }
+    Some(sums.shape())
 }
 
 /// The motion shapes of the examples that moved ([`motion_shape`]), read once for
 /// [`mean_shape`] and [`shape_spread`].
-pub fn example_shapes(logs: &[PoseLog]) -> Vec<[f32; 3]> {
+pub fn example_shapes(logs: &[PoseLog]) -> Vec<Shape> {
     logs.iter().filter_map(motion_shape).collect()
 }
 
-/// How far the shapes lie from their mean ([`mean_shape`]): the largest distance of one from
-/// it. None without shapes.
-pub fn shape_spread(shapes: &[[f32; 3]]) -> Option<f32> {
+/// How far the shapes lie from their mean ([`mean_shape`]): the largest
+/// [`shape_distance`] of one from it. None without shapes.
+pub fn shape_spread(shapes: &[Shape]) -> Option<f32> {
     let mean = mean_shape(shapes)?;
     shapes
         .iter()
-        .map(|s| {
-            let d2: f32 = s.iter().zip(&mean).map(|(a, b)| (a - b) * (a - b)).sum();
-            d2.sqrt()
-        })
+        .map(|s| shape_distance(&mean, s))
         .reduce(f32::max)
 }
 
 /// The mean of motion shapes ([`example_shapes`]); None without shapes.
-pub fn mean_shape(shapes: &[[f32; 3]]) -> Option<[f32; 3]> {
+pub fn mean_shape(shapes: &[Shape]) -> Option<Shape> {
     if shapes.is_empty() {
         return None;
     }
     let n = shapes.len() as f32;
-    Some([0, 1, 2].map(|k| shapes.iter().map(|s| s[k]).sum::<f32>() / n))
+    Some(core::array::from_fn(|k| {
+        shapes.iter().map(|s| s[k]).sum::<f32>() / n
+    }))
 }
 
 /// The span (seconds, log clock) from the first to the last motion of a one-gesture log.
@@ -724,6 +733,39 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
     Ok(None)
 }
 
+/// Which examples to mirror so that all are performed to the side of the median-length one:
+/// those whose mirror image is closer to it, compared by [`side_keys`].
+fn to_one_side(seqs: &[Tokenized]) -> Vec<bool> {
+    let mut order: Vec<usize> = (0..seqs.len()).collect();
+    order.sort_by_key(|&i| seqs[i].len());
+    let Some(&r) = order.get(order.len() / 2) else {
+        return Vec::new();
+    };
+    let reference = side_keys(&seqs[r]);
+    seqs.iter()
+        .map(|s| {
+            edit_distance(&side_keys(&mirror_seq(s)), &reference)
+                < edit_distance(&side_keys(s), &reference)
+        })
+        .collect()
+}
+
+/// What tells a performance's side: each run's translation when it translates, else its
+/// rotation — not the wobble marks or the tilt of a stroke, which differ between performances
+/// of the same side and would hide a mirrored one.
+fn side_keys(s: &Tokenized) -> Vec<Token> {
+    s.iter()
+        .map(|&(t, _)| {
+            let lin = (t & 0x3ff) / 27;
+            if t & ANY_LIN == 0 && lin != NONE_BIN {
+                lin
+            } else {
+                27 + (t & 0x3ff) % 27
+            }
+        })
+        .collect()
+}
+
 fn mirror_seq(s: &Tokenized) -> Tokenized {
     // A mirror flips signs, not axes: the wobble axes stay.
     let flags = ANY_LIN | ANY_ROT | WOBBLE_AXES;
@@ -768,20 +810,12 @@ pub fn learn_action(
         seqs.push(tok);
     }
     if mirror {
-        // Bring every example to the side of the median-length one, so a left and a right
-        // performance average and align as the same gesture (the mirror is added back below).
-        let mut order: Vec<usize> = (0..seqs.len()).collect();
-        order.sort_by_key(|&i| seqs[i].len());
-        if let Some(&r) = order.get(order.len() / 2) {
-            let reference = tokens_only(&seqs[r]);
-            for i in 0..seqs.len() {
-                let m = mirror_seq(&seqs[i]);
-                if edit_distance(&tokens_only(&m), &reference)
-                    < edit_distance(&tokens_only(&seqs[i]), &reference)
-                {
-                    seqs[i] = m;
-                    dtw::mirror_span(&mut spans[i]);
-                }
+        // Bring every example to one side, so a left and a right performance average and
+        // align as the same gesture (the mirror is added back below).
+        for (i, flip) in to_one_side(&seqs).into_iter().enumerate() {
+            if flip {
+                seqs[i] = mirror_seq(&seqs[i]);
+                dtw::mirror_span(&mut spans[i]);
             }
         }
     }
@@ -971,6 +1005,30 @@ mod tests {
     }
 
     /// Whether `re` accepts the token string `tokens` (names separated by spaces) exactly.
+    #[test]
+    fn examples_to_the_other_side_are_mirrored_whatever_their_wobbles() {
+        let seq = |names: &str| -> Tokenized {
+            names
+                .split_whitespace()
+                .map(|n| {
+                    let (name, wobble) = n.strip_suffix('~').map_or((n, false), |b| (b, true));
+                    let t = parse_token(name).unwrap();
+                    (if wobble { t | ANY_ROT } else { t }, 0.2)
+                })
+                .collect()
+        };
+        // A sidestep to the left (its hops learnt with roll wobbles), the median one to the
+        // left with other marks, and one to the right in plain tokens: only the right one
+        // turns, though no token of it equals one of the reference's.
+        let seqs = [
+            seq("lu.Zn ld~ lu~ ld~ l"),
+            seq("lu~ ld.Zp lu.Zn ld~ lu"),
+            seq("ru rd ru rd"),
+        ];
+        assert_eq!(to_one_side(&seqs), [false, false, true]);
+        assert!(to_one_side(&[]).is_empty());
+    }
+
     fn accepts(re: &Regex, tokens: &str) -> bool {
         re.compile()
             .unwrap()

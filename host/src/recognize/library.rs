@@ -10,7 +10,10 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use figurine_recognizer::pattern::{LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES};
+use figurine_recognizer::features::Shape;
+use figurine_recognizer::pattern::{
+    LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES, SHAPE_TURN_MAX,
+};
 use figurine_recognizer::token::{parse_token, Token, TokenName};
 use figurine_recognizer::Library;
 use serde::{Deserialize, Serialize};
@@ -42,9 +45,14 @@ pub struct ActionEntry {
     /// absent for a pattern written by hand.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<[f32; 3]>,
-    /// How far the examples' own shapes lie from [`ActionEntry::shape`] (the largest
-    /// distance, in the same shares): a match whose shape lies as close costs no merit. A kick
-    /// flicked flat or high varies where a walk's hops do not.
+    /// The rest of the examples' motion shape (`figurine_recognizer::features::Shape`):
+    /// `ln(1 + angle turned, rad)` and the share of the time spent still, averaged over the
+    /// examples; absent in a library learnt before they were measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_turn_still: Option<[f32; 2]>,
+    /// How far the examples' own shapes lie from their mean (the largest
+    /// `figurine_recognizer::segment::shape_distance`): a match whose shape lies as close
+    /// costs no merit. A kick flicked flat or high varies where a walk's hops do not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_spread: Option<f32>,
 }
@@ -128,6 +136,7 @@ impl ActionEntry {
             compiled: None,
             examples,
             shape: None,
+            shape_turn_still: None,
             shape_spread: None,
         };
         let c = Regex::parse(regex)?.compile()?;
@@ -136,10 +145,21 @@ impl ActionEntry {
         Ok(e)
     }
 
-    /// The same entry with motion shape `shape` (see [`ActionEntry::shape`]).
-    pub fn with_shape(mut self, shape: Option<[f32; 3]>) -> Self {
-        self.shape = shape;
+    /// The same entry with motion shape `shape` (see [`ActionEntry::shape`] and
+    /// [`ActionEntry::shape_turn_still`]).
+    pub fn with_shape(mut self, shape: Option<Shape>) -> Self {
+        self.shape = shape.map(|s| [s[0], s[1], s[2]]);
+        self.shape_turn_still = shape
+            .map(|s| [s[3], s[4]])
+            .filter(|t| t.iter().all(|x| x.is_finite()));
         self
+    }
+
+    /// The entry's motion shape, NaN where it has none recorded.
+    pub fn full_shape(&self) -> Option<Shape> {
+        let [l, u, f] = self.shape?;
+        let [t, s] = self.shape_turn_still.unwrap_or([f32::NAN; 2]);
+        Some([l, u, f, t, s])
     }
 
     /// The same entry with shape spread `spread` (see [`ActionEntry::shape_spread`]).
@@ -148,15 +168,23 @@ impl ActionEntry {
         self
     }
 
-    /// The device's shape-table entry: the three shares × 255, and 1 + the spread × 254
-    /// (0 when there is no shape).
+    /// The device's shape-table entry (layout in `figurine_recognizer::pattern`); all zero
+    /// when there is no shape. A shape learnt before the turn and still share were measured
+    /// has none: the device would read zeros as a gesture that neither turns nor holds.
     fn shape_bytes(&self) -> [u8; SHAPE_BYTES] {
-        match self.shape {
+        match self.full_shape() {
             Some(s) if s.iter().all(|x| x.is_finite()) => {
                 let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
                 let spread = self.shape_spread.filter(|x| x.is_finite()).unwrap_or(0.0);
                 let k = 1 + (spread.clamp(0.0, 1.0) * 254.0).round() as u8;
-                [q(s[0]), q(s[1]), q(s[2]), k]
+                [
+                    q(s[0]),
+                    q(s[1]),
+                    q(s[2]),
+                    k,
+                    q(s[3] / SHAPE_TURN_MAX),
+                    q(s[4]),
+                ]
             }
             _ => [0; SHAPE_BYTES],
         }
@@ -289,17 +317,19 @@ mod tests {
     #[test]
     fn a_learnt_shape_reaches_the_device_and_a_hand_written_pattern_has_none() {
         let mut lib = LibraryFile::default();
+        let shape = [0.05, 0.6, 0.8, 1.2, 0.3];
         let hop = ActionEntry::new("hop", "(uf df)+", None, vec![])
             .unwrap()
-            .with_shape(Some([0.05, 0.6, 0.8]))
+            .with_shape(Some(shape))
             .with_shape_spread(Some(0.1));
         lib.upsert(hop);
         lib.upsert(ActionEntry::new("slide", "l+ r+ l+", Some(1), vec![]).unwrap());
         let blob = lib.blob().unwrap();
         let dev = Library::from_bytes(&blob).unwrap();
         let s = dev.shape(0).unwrap();
-        for (got, want) in s.iter().zip([0.05, 0.6, 0.8]) {
-            assert!((got - want).abs() <= 0.5 / 255.0 + 1e-6, "{s:?}");
+        let step = [1.0, 1.0, 1.0, SHAPE_TURN_MAX, 1.0];
+        for ((got, want), k) in s.iter().zip(shape).zip(step) {
+            assert!((got - want).abs() <= 0.5 * k / 255.0 + 1e-6, "{s:?}");
         }
         assert_eq!(dev.shape(1), None);
         assert!((dev.shape_spread(0) - 0.1).abs() <= 0.5 / 254.0 + 1e-6);
@@ -307,9 +337,14 @@ mod tests {
         // The JSON keeps it; an entry without one writes no `shape` at all.
         let text = serde_json::to_string(&lib).unwrap();
         assert_eq!(text.matches("\"shape\"").count(), 1, "{text}");
-        let back = LibraryFile::from_json(&text).unwrap();
-        assert_eq!(back.actions[0].shape, Some([0.05, 0.6, 0.8]));
+        let mut back = LibraryFile::from_json(&text).unwrap();
+        assert_eq!(back.actions[0].full_shape(), Some(shape));
         assert_eq!(back.actions[0].shape_spread, Some(0.1));
         assert_eq!(back.actions[1].shape, None);
+        // A library learnt before the turn and the still share were measured keeps its three
+        // shares in the JSON, but the device gets no shape rather than a wrong one.
+        back.actions[0].shape_turn_still = None;
+        let dev_blob = back.blob().unwrap();
+        assert_eq!(Library::from_bytes(&dev_blob).unwrap().shape(0), None);
     }
 }

@@ -197,7 +197,7 @@ fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
     )
     .ok()
     .map(|e| {
-        e.with_shape(entry.shape)
+        e.with_shape(entry.full_shape())
             .with_shape_spread(entry.shape_spread)
     })
 }
