@@ -10,7 +10,10 @@
 //! every example rose, a punch thrown without its wind-up. A child expects the toy to answer
 //! it. Such a phrase is compared whole with every action ([`weighted_cost`]) and reported as
 //! the nearest one when it is within the share of edits every match is held to
-//! ([`EDIT_SHARE`]), without the action's own bound; otherwise nothing is reported.
+//! ([`EDIT_SHARE`]), without the action's own bound — or within the looser [`LOOSE_SHARE`]
+//! when no other action is that near and the phrase moved as the action's examples did (its
+//! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example);
+//! otherwise nothing is reported.
 //!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
 //! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
@@ -22,6 +25,7 @@ use crate::alignment::{weighted_cost, FULL};
 use crate::automaton::prefix_alive;
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
+use crate::recognizer::shape_of;
 use crate::segment::{Candidate, EDIT_SHARE, HOLD_US};
 use crate::token::{Token, STILL};
 
@@ -92,7 +96,8 @@ pub struct Nearest {
 }
 
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
-/// phrase, when one is near enough ([`EDIT_SHARE`]). Ties of cost per aligned token go to the lower action index.
+/// phrase, when one is near enough ([`EDIT_SHARE`], or [`LOOSE_SHARE`] as the module docs
+/// say). Ties of cost per aligned token go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
 /// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary (the stream
 /// began there), not the end of an event.
@@ -120,15 +125,17 @@ pub fn nearest_action(
         });
     }
     let mut best: Option<(Candidate, usize)> = None;
+    let mut loose = 0usize;
     for a in 0..lib.len() {
         let Some(p) = lib.pattern(a) else { continue };
         let aligned = n.max(p.min_len());
-        // Within the share: cost ≤ FULL · aligned · e / t half-edits.
-        let (e, t) = EDIT_SHARE;
+        // Within the loose share: cost ≤ FULL · aligned · e / t half-edits.
+        let (e, t) = LOOSE_SHARE;
         let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
         let Some(cost) = weighted_cost(&p, tokens, bound) else {
             continue;
         };
+        loose += 1;
         let c = Candidate {
             action: a as u8,
             start: first,
@@ -148,11 +155,31 @@ pub fn nearest_action(
             best = Some((c, aligned));
         }
     }
+    // Within the share every match is held to; or within the loose share when no other
+    // action comes that near and the phrase moved as the action's examples did (a sudden
+    // sidestep's lone hop, which only the sidestep is anywhere near).
+    let (e, t) = EDIT_SHARE;
+    let candidate = best
+        .filter(|(c, aligned)| {
+            usize::from(c.cost) * t <= usize::from(FULL) * aligned * e
+                || (loose == 1 && shape_agrees(lib, usize::from(c.action), hist, first, last))
+        })
+        .map(|(c, _)| c);
     Some(Nearest {
-        candidate: best.map(|(c, _)| c),
+        candidate,
         open: false,
     })
 }
+
+/// Whether runs `first..=last` moved as action `a`'s examples did: it has a shape, and
+/// theirs lies within its spread ([`shape_of`] charges nothing).
+fn shape_agrees(lib: &Library<'_>, a: usize, hist: &History, first: u32, last: u32) -> bool {
+    lib.shape(a).is_some() && shape_of(lib, a, hist, first, last) == 0
+}
+
+/// Edits per token a stand-alone phrase may be off its nearest action when no other action
+/// is as near and its shape is the action's ([`nearest_action`]), as (edits, tokens).
+pub const LOOSE_SHARE: (usize, usize) = (1, 2);
 
 #[cfg(test)]
 mod tests {
@@ -221,6 +248,40 @@ mod tests {
             nearest_action(&lib, &h, 0, false, 2).unwrap().candidate,
             None
         );
+        // … unless the kick's examples left a shape the phrase moves like (these runs carry
+        // no motion sums: no evidence against it) and no other action is within the loose
+        // share: then it is the kick.
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 0, 255, 0, 0]); 3]);
+        let with_shapes = Library::from_bytes(&shaped).unwrap();
+        let c = nearest_action(&with_shapes, &h, 0, false, 2)
+            .unwrap()
+            .candidate
+            .unwrap();
+        assert_eq!((c.action, c.cost), (2, HALF + FULL));
+    }
+
+    #[test]
+    fn the_loose_share_needs_one_action_alone_near_and_its_shape() {
+        // A lone `u`: the end of a crouch `d+ u+`, one whole edit in two aligned tokens.
+        let h = history(&[("_", 800), ("u", 200), ("_", 150)]);
+        let shape = Some([0, 255, 0, 0, 0]);
+        let crouch_only = lib_blob();
+        let shaped = crate::pattern::tests::with_shapes(&crouch_only, &[shape; 3]);
+        let lib = Library::from_bytes(&shaped).unwrap();
+        let found = |lib: &Library<'_>| nearest_action(lib, &h, 0, false, 1).unwrap().candidate;
+        assert_eq!(found(&lib).map(|c| c.action), Some(1));
+        // Without a shape learnt for it: nothing.
+        let unshaped = crate::pattern::tests::with_shapes(&crouch_only, &[shape, None, shape]);
+        assert_eq!(found(&Library::from_bytes(&unshaped).unwrap()), None);
+        // With a second action as near (`l+ u+`): nothing either.
+        let two = seq_library(&[
+            (&["b", "f", "b"], 2),
+            (&["d", "u"], 1),
+            (&["uf.Xn", "b.Xp", "db"], 0),
+            (&["l", "u"], 1),
+        ]);
+        let shaped = crate::pattern::tests::with_shapes(&two, &[shape; 4]);
+        assert_eq!(found(&Library::from_bytes(&shaped).unwrap()), None);
     }
 
     #[test]

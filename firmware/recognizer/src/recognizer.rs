@@ -624,7 +624,13 @@ impl<'lib> Recognizer<'lib> {
 /// when the library has no shape for it.
 // Once per candidate, not per sample: one out-of-line copy (flash).
 #[inline(never)]
-fn shape_of(library: &Library<'_>, a: usize, hist: &History, start: u32, end: u32) -> i16 {
+pub(crate) fn shape_of(
+    library: &Library<'_>,
+    a: usize,
+    hist: &History,
+    start: u32,
+    end: u32,
+) -> i16 {
     match library.shape(a) {
         Some(expected) => shape_penalty(
             expected,
