@@ -265,13 +265,13 @@ mod tests {
         // A lone `u`: the end of a crouch `d+ u+`, one whole edit in two aligned tokens.
         let h = history(&[("_", 800), ("u", 200), ("_", 150)]);
         let shape = Some([0, 255, 0, 0, 0]);
-        let crouch_only = lib_blob();
-        let shaped = crate::pattern::tests::with_shapes(&crouch_only, &[shape; 3]);
+        let blob = lib_blob();
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[shape; 3]);
         let lib = Library::from_bytes(&shaped).unwrap();
         let found = |lib: &Library<'_>| nearest_action(lib, &h, 0, false, 1).unwrap().candidate;
         assert_eq!(found(&lib).map(|c| c.action), Some(1));
         // Without a shape learnt for it: nothing.
-        let unshaped = crate::pattern::tests::with_shapes(&crouch_only, &[shape, None, shape]);
+        let unshaped = crate::pattern::tests::with_shapes(&blob, &[shape, None, shape]);
         assert_eq!(found(&Library::from_bytes(&unshaped).unwrap()), None);
         // With a second action as near (`l+ u+`): nothing either.
         let two = seq_library(&[

@@ -722,8 +722,8 @@ mod tests {
         let with = crate::pattern::tests::with_shapes;
         assert_eq!(actions(&with(&v1, &[skim, bob])), [1]);
         assert_eq!(actions(&with(&v1, &[bob, skim])), [0]);
-        // Two bobs, one of which turns (ln(1 + angle) = 2 × 100 / 255 ≈ 0.8, a turn of about
-        // 1.2 rad) and holds a third of its time: the hop, which does neither, is the other's.
+        // Two bobs, one of which turns (ln(1 + angle) = 4 × 100 / 255 ≈ 1.6, a turn of about
+        // 3.8 rad) and holds a third of its time: the hop, which does neither, is the other's.
         let twisting = Some([0, 150, 200, 100, 85]);
         assert_eq!(actions(&with(&v1, &[twisting, bob])), [1]);
         assert_eq!(actions(&with(&v1, &[bob, twisting])), [0]);

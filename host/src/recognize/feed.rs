@@ -123,20 +123,22 @@ pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
     runs
 }
 
+/// The runs of a one-performance log's gesture, through the wire as the device sees them
+/// ([`gesture_runs`]); empty without motion.
+pub fn log_gesture(log: &PoseLog) -> Vec<Run> {
+    let (samples, _) = log_samples(log);
+    gesture_runs(&log_runs(&samples)).to_vec()
+}
+
 /// Feature sums over the gesture of a one-performance log (its runs from the first to the
 /// last motion); None without motion.
 pub fn gesture_accum(log: &PoseLog) -> Option<Accum> {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g = gesture_runs(&runs);
-    if g.is_empty() {
-        return None;
-    }
-    let mut acc = Accum::new();
-    for r in g {
+    let g = log_gesture(log);
+    let first = g.first()?.acc;
+    Some(g.iter().skip(1).fold(first, |mut acc, r| {
         acc.merge(&r.acc);
-    }
-    Some(acc)
+        acc
+    }))
 }
 
 /// The runs of a one-gesture log between its first and last motion (leading and trailing

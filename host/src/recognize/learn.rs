@@ -41,7 +41,7 @@ use figurine_recognizer::token::{
 use figurine_recognizer::Library;
 
 use super::dtw;
-use super::feed::{gesture_runs, log_runs, log_samples};
+use super::feed::{gesture_runs, log_gesture, log_runs, log_samples};
 use super::library::{parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
 use super::regex::{default_edits, Regex};
 use crate::poselog::PoseLog;
@@ -92,14 +92,12 @@ pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
 /// (`figurine_recognizer::features::Shape`) — what the device measures over a match
 /// (`figurine_recognizer::segment::shape_penalty`). None without motion.
 pub fn motion_shape(log: &PoseLog) -> Option<Shape> {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g = gesture_runs(&runs);
+    let g = log_gesture(log);
     if g.is_empty() {
         return None;
     }
     let mut sums = ShapeSums::new();
-    for r in g {
+    for r in &g {
         sums.add(&r.acc, r.token == STILL);
     }
     Some(sums.shape())
