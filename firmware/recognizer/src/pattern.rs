@@ -215,10 +215,9 @@ pub struct Library<'a> {
     bytes: &'a [u8],
     n: usize,
     offsets: [u16; MAX_ACTIONS],
-    /// Offset of the shape table (0: none, a version 1 blob).
+    /// Offset of the shape table (0: none — a version 1 blob, or a version 2 one, whose
+    /// shapes lack two dimensions and are not used).
     shapes: u16,
-    /// Bytes per entry of the shape table.
-    shape_bytes: u8,
 }
 
 impl<'a> Library<'a> {
@@ -229,7 +228,6 @@ impl<'a> Library<'a> {
             n: 0,
             offsets: [0; MAX_ACTIONS],
             shapes: 0,
-            shape_bytes: 0,
         }
     }
 
@@ -281,7 +279,9 @@ impl<'a> Library<'a> {
                     return Err(Error::Invalid("shape table"));
                 }
             }
-            shapes = at as u16;
+            if stride == SHAPE_BYTES {
+                shapes = at as u16;
+            }
             at += stride * n;
         }
         if at != bytes.len() {
@@ -292,14 +292,13 @@ impl<'a> Library<'a> {
             n,
             offsets,
             shapes,
-            shape_bytes: stride as u8,
         })
     }
 
     /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2
     /// library's shapes lack two dimensions and are not used).
     pub fn shape(&self, i: usize) -> Option<Shape> {
-        if usize::from(self.shape_bytes) != SHAPE_BYTES || i >= self.n {
+        if self.shapes == 0 || i >= self.n {
             return None;
         }
         let at = usize::from(self.shapes) + SHAPE_BYTES * i;
@@ -321,7 +320,7 @@ impl<'a> Library<'a> {
         if self.shapes == 0 || i >= self.n {
             return 0.0;
         }
-        let at = usize::from(self.shapes) + usize::from(self.shape_bytes) * i + 3;
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i + 3;
         match self.bytes.get(at) {
             Some(&k) if k > 1 => f32::from(k - 1) / 254.0,
             _ => 0.0,

@@ -32,6 +32,7 @@ use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::features::{Accum, Shape, ShapeSums, ANGVEL, SPEED};
+use figurine_recognizer::history::Run;
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
 use figurine_recognizer::segment::{edits_fit, shape_distance};
 use figurine_recognizer::token::{
@@ -72,32 +73,62 @@ pub struct LearnArgs {
 /// One tokenized gesture: (token, duration in seconds) per run, STILL removed.
 pub type Tokenized = Vec<(Token, f64)>;
 
+/// One example log, read once through the device front end: its gesture's runs (STILL
+/// included) and the span (seconds, log clock) from its first to its last motion.
+struct Example {
+    runs: Vec<Run>,
+    span: Option<(f64, f64)>,
+}
+
+impl Example {
+    fn read(log: &PoseLog) -> Self {
+        let (samples, _) = log_samples(log);
+        let runs = log_runs(&samples);
+        let g = gesture_runs(&runs);
+        let clock = super::feed::Clock::new(log, &samples);
+        let span = g
+            .first()
+            .zip(g.last())
+            .map(|(a, b)| (clock.time_of(a.start.0), clock.time_of(b.end.0)));
+        Example {
+            runs: g.to_vec(),
+            span,
+        }
+    }
+}
+
 /// Tokenizes the gesture of a one-performance log.
 pub fn tokenize_gesture(log: &PoseLog) -> Tokenized {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    gesture_runs(&runs)
-        .iter()
+    tokens_of(&log_gesture(log))
+}
+
+/// The moving runs of a gesture as (token, duration).
+fn tokens_of(g: &[Run]) -> Tokenized {
+    g.iter()
         .filter(|r| r.token != STILL)
-        .map(|r| {
-            (
-                r.token,
-                (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01,
-            )
-        })
+        .map(|r| (r.token, run_seconds(r)))
         .collect()
+}
+
+/// A run's duration as the learner weighs it, seconds (one tick more than first to last).
+fn run_seconds(r: &Run) -> f64 {
+    (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01
 }
 
 /// The motion shape of a one-performance log's gesture, from its first to its last motion
 /// (`figurine_recognizer::features::Shape`) — what the device measures over a match
 /// (`figurine_recognizer::segment::shape_penalty`). None without motion.
 pub fn motion_shape(log: &PoseLog) -> Option<Shape> {
-    let g = log_gesture(log);
+    shape_of_runs(&log_gesture(log))
+}
+
+/// [`motion_shape`] of a gesture's runs.
+fn shape_of_runs(g: &[Run]) -> Option<Shape> {
     if g.is_empty() {
         return None;
     }
     let mut sums = ShapeSums::new();
-    for r in &g {
+    for r in g {
         sums.add(&r.acc, r.token == STILL);
     }
     Some(sums.shape())
@@ -128,16 +159,6 @@ pub fn mean_shape(shapes: &[Shape]) -> Option<Shape> {
     Some(core::array::from_fn(|k| {
         shapes.iter().map(|s| s[k]).sum::<f32>() / n
     }))
-}
-
-/// The span (seconds, log clock) from the first to the last motion of a one-gesture log.
-fn motion_span(log: &PoseLog) -> Option<(f64, f64)> {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g = gesture_runs(&runs);
-    let (first, last) = (g.first()?, g.last()?);
-    let clock = super::feed::Clock::new(log, &samples);
-    Some((clock.time_of(first.start.0), clock.time_of(last.end.0)))
 }
 
 /// Rotation (rad) below which a run's rotation half is a wobble, not part of the gesture.
@@ -210,13 +231,12 @@ pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
 /// than [`INCIDENTAL_PATH_SHARE`] of the path) becomes a wildcard, so `d.Xp` with a 5° tilt is
 /// learnt as `d~`.
 pub fn intent_symbols(log: &PoseLog) -> Tokenized {
-    let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
-    let g: Vec<_> = gesture_runs(&runs)
-        .iter()
-        .filter(|r| r.token != STILL)
-        .copied()
-        .collect();
+    intent_of(&log_gesture(log))
+}
+
+/// [`intent_symbols`] of a gesture's runs.
+fn intent_of(runs: &[Run]) -> Tokenized {
+    let g: Vec<&Run> = runs.iter().filter(|r| r.token != STILL).collect();
     let dt = f64::from(figurine_recognizer::intake::TICK_S);
     let path: f64 = g.iter().map(|r| f64::from(r.acc.sum[SPEED]) * dt).sum();
     g.iter()
@@ -234,10 +254,7 @@ pub fn intent_symbols(log: &PoseLog) -> Tokenized {
             } else {
                 t
             };
-            (
-                sym,
-                (r.end.1.saturating_sub(r.start.1)) as f64 * 1e-6 + 0.01,
-            )
+            (sym, run_seconds(r))
         })
         .collect()
 }
@@ -795,18 +812,17 @@ pub fn learn_action(
     max_edits: Option<u8>,
     mirror: bool,
 ) -> Result<ActionEntry> {
-    let mut spans = Vec::new();
-    let mut seqs = Vec::new();
-    let mut raw_examples = Vec::new();
-    for log in logs {
-        raw_examples.push(tokenize_gesture(log));
-        let tok = intent_symbols(log);
-        let span = motion_span(log)
-            .map(|(t0, t1)| dtw::normalised_span(log, t0 - 0.05, t1 + 0.05))
-            .unwrap_or_default();
-        spans.push(span);
-        seqs.push(tok);
-    }
+    let read: Vec<Example> = logs.iter().map(Example::read).collect();
+    let mut spans: Vec<_> = logs
+        .iter()
+        .zip(&read)
+        .map(|(log, e)| {
+            e.span
+                .map(|(t0, t1)| dtw::normalised_span(log, t0 - 0.05, t1 + 0.05))
+                .unwrap_or_default()
+        })
+        .collect();
+    let mut seqs: Vec<Tokenized> = read.iter().map(|e| intent_of(&e.runs)).collect();
     if mirror {
         // Bring every example to one side, so a left and a right performance average and
         // align as the same gesture (the mirror is added back below).
@@ -826,10 +842,10 @@ pub fn learn_action(
         learn_regex(&all)?
     };
     let c = re.compile()?;
-    let shapes = example_shapes(logs);
-    let examples: Vec<String> = raw_examples
+    let shapes: Vec<Shape> = read.iter().filter_map(|e| shape_of_runs(&e.runs)).collect();
+    let examples: Vec<String> = read
         .iter()
-        .map(|s| tokens_to_string(&tokens_only(s)))
+        .map(|e| tokens_to_string(&tokens_only(&tokens_of(&e.runs))))
         .collect();
     let entry = ActionEntry::new(
         name,
