@@ -87,7 +87,10 @@ fn main() -> anyhow::Result<()> {
         Cmd::E2e => tasks::e2e(),
         Cmd::Soak { seconds, rate } => tasks::soak(seconds, rate),
         Cmd::Test => tasks::test(),
-        Cmd::Firmware { board, debug } => tasks::firmware(board, !debug),
+        Cmd::Firmware { board, debug } => {
+            setup::rust_target()?;
+            tasks::firmware(board, !debug)
+        }
         Cmd::Fuzz {
             seconds,
             runs,

@@ -33,8 +33,9 @@ fn dpkg_installed(pkg: &str) -> bool {
         .is_some_and(|s| s.contains("install ok installed"))
 }
 
-/// Installs what is missing; returns an error with a clear message when it cannot.
-pub fn setup() -> Result<()> {
+/// The Rust target and components the firmware build and its size report need (rustup
+/// skips what is already installed).
+pub fn rust_target() -> Result<()> {
     step("setup: Rust target and components");
     run(Command::new("rustup").current_dir(root()).args([
         "target",
@@ -47,7 +48,12 @@ pub fn setup() -> Result<()> {
         "llvm-tools",
         "rustfmt",
         "clippy",
-    ]))?;
+    ]))
+}
+
+/// Installs what is missing; returns an error with a clear message when it cannot.
+pub fn setup() -> Result<()> {
+    rust_target()?;
 
     step("setup: Debian packages");
     let missing: Vec<&str> = APT_PACKAGES

@@ -13,10 +13,12 @@
 //! or fade no translation quantity sees.
 //!
 //! [`Accum`] keeps count, Σx and Σx² per quantity (one per token run: any segment's statistics
-//! are the sum of its runs' accumulators). [`segment_features`] turns an accumulator into the
-//! 58 features — the mean of each quantity, then its *relative* spread (standard deviation
-//! over mean, the coefficient of variation) — in the log domain `ln(FEATURE_EPS + x)`, where
-//! Gaussian naive Bayes fits much better than on the raw, heavy-tailed values. Means carry the
+//! are the sum of its runs' accumulators), and how far the figurine rose and how high it was
+//! over the ticks, from which a span's [`Shape`] follows ([`ShapeSums`]).
+//! [`segment_features`] turns an accumulator into the 58 features — the mean of each
+//! quantity, then its *relative* spread (standard deviation over mean, the coefficient of
+//! variation) — in the log domain `ln(FEATURE_EPS + x)`, where Gaussian naive Bayes fits much
+//! better than on the raw, heavy-tailed values. Means carry the
 //! tempo (they are rates per second once divided by the mean speed); the relative spread is
 //! free of both size and duration and carries the shape of the effort: accelerations
 //! concentrated in a short impact spread far more than evenly eased ones. The seed's plain
@@ -81,7 +83,7 @@ pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
     "ang.slowdown",
 ];
 
-/// Sums over a set of ticks. 236 bytes.
+/// Sums over a set of ticks, in order. 244 bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accum {
     /// Number of ticks.
@@ -90,6 +92,11 @@ pub struct Accum {
     pub sum: [f32; QUANTITIES],
     /// Σ x² per quantity.
     pub sum_sq: [f32; QUANTITIES],
+    /// How far the figurine rose over the ticks (world up), m.
+    pub rise: f32,
+    /// Σ over the ticks of the height after each, above where the first began, m·ticks:
+    /// whether the motion went up and came back (a jump) or down and came back (a crouch).
+    pub lift: f32,
 }
 
 impl Default for Accum {
@@ -105,11 +112,16 @@ impl Accum {
             n: 0,
             sum: [0.0; QUANTITIES],
             sum_sq: [0.0; QUANTITIES],
+            rise: 0.0,
+            lift: 0.0,
         }
     }
 
-    /// Adds one tick's quantities.
-    pub fn add(&mut self, q: &[f32; QUANTITIES]) {
+    /// Adds one tick's quantities after the ticks already added; the figurine rose `rise` m
+    /// (world up) during it.
+    pub fn add(&mut self, q: &[f32; QUANTITIES], rise: f32) {
+        self.rise += rise;
+        self.lift += self.rise;
         self.n = self.n.saturating_add(1);
         for ((s, s2), &x) in self.sum.iter_mut().zip(self.sum_sq.iter_mut()).zip(q) {
             *s += x;
@@ -117,11 +129,13 @@ impl Accum {
         }
     }
 
-    /// Adds another accumulator.
+    /// Adds another accumulator, whose ticks came after these.
     // Out of line: merges happen at run joins and commits, not per tick, and each inlined
     // copy costs flash.
     #[inline(never)]
     pub fn merge(&mut self, o: &Accum) {
+        self.lift += o.lift + self.rise * o.n as f32;
+        self.rise += o.rise;
         self.n = self.n.saturating_add(o.n);
         for i in 0..QUANTITIES {
             if let (Some(s), Some(s2), Some(x), Some(x2)) = (
@@ -184,13 +198,15 @@ pub fn motion_shape(sums: [f32; 3], speed: f32, n: u32) -> [f32; 3] {
 }
 
 /// Dimensions of a [`Shape`].
-pub const SHAPE_DIMS: usize = 5;
+pub const SHAPE_DIMS: usize = 6;
 
 /// How a span of motion moved, whatever its size, speed and place: mean |velocity| along the
 /// object's left, up and front axes, each as a share of the mean speed ([`motion_shape`]);
 /// `ln(1 + angle turned)` (rad, the three axes' turning combined: a kick's lean, a throw's
 /// swing and a punch's twist differ in it where their strokes do not); and the share of its
-/// time spent still (a crouch is held low, a jump is not).
+/// time spent still (a crouch is held low, a jump is not); and how high it was on average
+/// (world up, above where it began, over its duration) as a share of its path length —
+/// positive for a jump, negative for a crouch, whose strokes alone may read alike.
 pub type Shape = [f32; SHAPE_DIMS];
 
 /// Sums over a span of token runs from which its [`Shape`] follows.
@@ -201,6 +217,8 @@ pub struct ShapeSums {
     speed: f32,
     ticks: u32,
     still: u32,
+    height: f32,
+    lift: f32,
 }
 
 impl ShapeSums {
@@ -212,11 +230,15 @@ impl ShapeSums {
             speed: 0.0,
             ticks: 0,
             still: 0,
+            height: 0.0,
+            lift: 0.0,
         }
     }
 
-    /// Adds a run's sums; `still`: the run is STILL.
+    /// Adds a run's sums (the run after those added); `still`: the run is STILL.
     pub fn add(&mut self, acc: &Accum, still: bool) {
+        self.lift += acc.lift + self.height * acc.n as f32;
+        self.height += acc.rise;
         for k in 0..3 {
             self.lin[k] += acc.sum[k];
             self.turn[k] += acc.sum[ANGVEL + k];
@@ -232,8 +254,12 @@ impl ShapeSums {
     pub fn shape(&self) -> Shape {
         let [l, u, f] = motion_shape(self.lin, self.speed, self.ticks);
         let angle = TICK_S * fmath::norm3(self.turn);
-        let still = self.still as f32 / fmath::max(self.ticks as f32, 1.0);
-        [l, u, f, fmath::ln(1.0 + angle), still]
+        let ticks = fmath::max(self.ticks as f32, 1.0);
+        let still = self.still as f32 / ticks;
+        // Mean height / path: lift (m·ticks) / (Σ speed (m/s·ticks) · TICK_S · ticks).
+        let path = fmath::max(self.speed, SPEED_FLOOR * ticks) * TICK_S;
+        let height = self.lift / (path * ticks);
+        [l, u, f, fmath::ln(1.0 + angle), still, height]
     }
 }
 
@@ -335,8 +361,8 @@ mod tests {
 
     #[test]
     fn a_shape_has_the_shares_the_turn_and_the_time_held() {
-        // 30 ticks moving up-and-forward at 0.6 / 0.8 m/s while pitching at 2 rad/s, then
-        // 10 ticks held still.
+        // 30 ticks moving up-and-forward at 0.6 / 0.8 m/s while pitching at 2 rad/s (rising
+        // 0.6 m/s in the world too), then 10 ticks held still up there.
         let mut moving = Accum::new();
         let mut q = [0.0; QUANTITIES];
         q[1] = 0.6;
@@ -344,25 +370,106 @@ mod tests {
         q[ANGVEL] = 2.0;
         q[SPEED] = 1.0;
         for _ in 0..30 {
-            moving.add(&q);
+            moving.add(&q, 0.6 * TICK_S);
         }
         let mut held = Accum::new();
         for _ in 0..10 {
-            held.add(&[0.0; QUANTITIES]);
+            held.add(&[0.0; QUANTITIES], 0.0);
         }
         let mut sums = ShapeSums::new();
         sums.add(&moving, false);
         sums.add(&held, true);
         let s = sums.shape();
-        let want = [0.0, 0.6, 0.8, libm::logf(1.0 + 30.0 * TICK_S * 2.0), 0.25];
+        // Height: Σ 0.006·i over the 30 rising ticks (2.79 m·ticks) and 10 ticks at 0.18 m
+        // (1.8), over 40 ticks — 0.11475 m on average — as a share of the 0.3 m path.
+        let want = [
+            0.0,
+            0.6,
+            0.8,
+            libm::logf(1.0 + 30.0 * TICK_S * 2.0),
+            0.25,
+            0.11475 / 0.3,
+        ];
         for (got, want) in s.iter().zip(want) {
             assert!((got - want).abs() < 1e-5, "{s:?}");
         }
         // Nothing added: no shares of a speed that is not there (NaN: no evidence, which
-        // `segment::shape_penalty` charges nothing for), no turn, nothing held.
+        // `segment::shape_penalty` charges nothing for), no turn, nothing held, no height.
         let empty = ShapeSums::new().shape();
         assert!(empty[..3].iter().all(|x| x.is_nan()), "{empty:?}");
-        assert_eq!(empty[3..], [0.0, 0.0]);
+        assert_eq!(empty[3..], [0.0, 0.0, 0.0]);
+    }
+
+    /// The ticks of a vertical stroke of `ticks` ticks that moves `dy` m (up if positive) at
+    /// an even speed, added one by one to `acc`.
+    fn stroke(acc: &mut Accum, ticks: u32, dy: f32) {
+        let mut q = [0.0; QUANTITIES];
+        let v = dy / (ticks as f32 * TICK_S);
+        q[1] = libm::fabsf(v);
+        q[SPEED] = libm::fabsf(v);
+        for _ in 0..ticks {
+            acc.add(&q, v * TICK_S);
+        }
+    }
+
+    /// Height of runs (strokes of (ticks, dy, held)) one after the other.
+    fn height(runs: &[(u32, f32, bool)]) -> f32 {
+        let mut sums = ShapeSums::new();
+        for &(ticks, dy, held) in runs {
+            let mut acc = Accum::new();
+            if held {
+                for _ in 0..ticks {
+                    acc.add(&[0.0; QUANTITIES], 0.0);
+                }
+            } else {
+                stroke(&mut acc, ticks, dy);
+            }
+            sums.add(&acc, held);
+        }
+        sums.shape()[5]
+    }
+
+    #[test]
+    fn a_jump_is_high_and_a_crouch_low_whatever_their_size() {
+        // A jump: a small dip, a flight up and back down, a small rise after landing.
+        let jump = |k: f32| {
+            height(&[
+                (20, -0.02 * k, false),
+                (30, 0.25 * k, false),
+                (30, -0.25 * k, false),
+                (20, 0.02 * k, false),
+            ])
+        };
+        // A crouch: down, held low, up.
+        let crouch =
+            |k: f32| height(&[(40, -0.1 * k, false), (50, 0.0, true), (50, 0.1 * k, false)]);
+        assert!(jump(1.0) > 0.1, "{}", jump(1.0));
+        assert!(crouch(1.0) < -0.2, "{}", crouch(1.0));
+        for k in [0.5, 2.0] {
+            assert!((jump(k) - jump(1.0)).abs() < 1e-5);
+            assert!((crouch(k) - crouch(1.0)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn merging_accumulators_in_order_is_adding_their_ticks() {
+        // Height sums depend on the order of the ticks: a merge appends.
+        let mut whole = Accum::new();
+        stroke(&mut whole, 7, 0.3);
+        stroke(&mut whole, 5, -0.1);
+        let mut a = Accum::new();
+        stroke(&mut a, 7, 0.3);
+        let mut b = Accum::new();
+        stroke(&mut b, 5, -0.1);
+        a.merge(&b);
+        assert_eq!(a.n, whole.n);
+        assert!((a.rise - whole.rise).abs() < 1e-6);
+        assert!(
+            (a.lift - whole.lift).abs() < 1e-5,
+            "{} vs {}",
+            a.lift,
+            whole.lift
+        );
     }
 
     fn kin(v: [f32; 3], a: [f32; 3], j: [f32; 3]) -> Kinematics {
@@ -453,7 +560,7 @@ mod tests {
                 } else {
                     0.0
                 };
-                a.add(&q);
+                a.add(&q, 0.0);
             }
             segment_features(&a)[QUANTITIES + 26]
         };
@@ -466,7 +573,7 @@ mod tests {
         let mut q = [0.0; QUANTITIES];
         for x in [1.0f32, 3.0] {
             q[0] = x;
-            a.add(&q);
+            a.add(&q, 0.0);
         }
         let f = segment_features(&a);
         // Mean relative to the (floored) mean speed of 1e-3 m/s; spread relative to the mean.

@@ -97,17 +97,18 @@ impl Frontend {
             };
             let k = kinematics(&sm);
             let q = self.features.quantities(&k);
+            let rise = k.world_v[1] * crate::intake::TICK_S;
             let at = (k.tick.seq, k.tick.sample_t_us);
             self.ticks = self.ticks.saturating_add(1);
             self.last_tick_us = k.tick.t_us;
             match self.tokenizer.step(&k) {
-                TokenStep::Run => self.extend_current(&q, at),
+                TokenStep::Run => self.extend_current(&q, rise, at),
                 TokenStep::Candidate => {
                     if self.cand.n == 0 {
                         self.cand_start = at;
                     }
                     self.cand_end = at;
-                    self.cand.add(&q);
+                    self.cand.add(&q, rise);
                 }
                 TokenStep::BlipMerged { starts_candidate } => {
                     let blip = core::mem::take(&mut self.cand);
@@ -119,15 +120,15 @@ impl Frontend {
                     if starts_candidate {
                         self.cand_start = at;
                         self.cand_end = at;
-                        self.cand.add(&q);
+                        self.cand.add(&q, rise);
                     } else {
-                        self.extend_current(&q, at);
+                        self.extend_current(&q, rise, at);
                     }
                 }
                 TokenStep::NewToken { token } => {
                     let start = if self.cand.n > 0 { self.cand_start } else { at };
                     let mut acc = core::mem::take(&mut self.cand);
-                    acc.add(&q);
+                    acc.add(&q, rise);
                     let index = self.history.open(token, start, acc);
                     if let Some(r) = self.history.newest_mut() {
                         r.end = at;
@@ -138,9 +139,14 @@ impl Frontend {
         }
     }
 
-    fn extend_current(&mut self, q: &[f32; crate::features::QUANTITIES], at: (u32, u64)) {
+    fn extend_current(
+        &mut self,
+        q: &[f32; crate::features::QUANTITIES],
+        rise: f32,
+        at: (u32, u64),
+    ) {
         if let Some(r) = self.history.newest_mut() {
-            r.acc.add(q);
+            r.acc.add(q, rise);
             r.end = at;
         }
     }

@@ -5,7 +5,7 @@
 //! ([`crate::features::Accum`]). Runs are addressed by an absolute index that counts every run
 //! since the recognizer started (wrapping u32). A match reaching further back than the ring is
 //! clipped to the oldest run still held (documented truncation; patterns are ≤ 32 tokens).
-//! RAM: `HISTORY_RUNS × 272` bytes ≈ 10.6 KiB.
+//! RAM: `HISTORY_RUNS × 280` bytes ≈ 10.9 KiB.
 
 use crate::features::Accum;
 use crate::token::{Token, STILL};

@@ -251,7 +251,7 @@ mod tests {
         // … unless the kick's examples left a shape the phrase moves like (these runs carry
         // no motion sums: no evidence against it) and no other action is within the loose
         // share: then it is the kick.
-        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 0, 255, 0, 0]); 3]);
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 0, 255, 0, 0, 128]); 3]);
         let with_shapes = Library::from_bytes(&shaped).unwrap();
         let c = nearest_action(&with_shapes, &h, 0, false, 2)
             .unwrap()
@@ -264,7 +264,7 @@ mod tests {
     fn the_loose_share_needs_one_action_alone_near_and_its_shape() {
         // A lone `u`: the end of a crouch `d+ u+`, one whole edit in two aligned tokens.
         let h = history(&[("_", 800), ("u", 200), ("_", 150)]);
-        let shape = Some([0, 255, 0, 0, 0]);
+        let shape = Some([0, 255, 0, 0, 0, 128]);
         let blob = lib_blob();
         let shaped = crate::pattern::tests::with_shapes(&blob, &[shape; 3]);
         let lib = Library::from_bytes(&shaped).unwrap();

@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (3; version 2, whose shape table has only the first 4
-//!         bytes of each entry, and version 1, without the table, are still read)
+//! 0   4   magic "FGL" + version byte (4; versions 3 and 2, whose shape tables have only the
+//!         first 6 and 4 bytes of each entry, and version 1, without the table, are still
+//!         read — their shapes are not used)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
 //! 5   3   reserved, zero
 //! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
@@ -24,16 +25,17 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 6 bytes per action in record order (the mean of its examples'
+//! then the shape table, 7 bytes per action in record order (the mean of its examples'
 //! shapes, `features::Shape`):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
-//! +3  1   0 = shape unknown (all six bytes are zero); else shape known (learnt from
+//! +3  1   0 = shape unknown (all seven bytes are zero); else shape known (learnt from
 //!         examples), and 1 + 254 × how far the examples' shapes lay from it (the largest
 //!         `segment::shape_distance`, rounded; 1 = the examples agree, or a library from
 //!         before the spread)
 //! +4  1   ln(1 + angle turned, rad) × 255 / SHAPE_TURN_MAX, rounded
 //! +5  1   share of the time spent still × 255, rounded
+//! +6  1   (1 + mean height above the start as a share of the path length) × 255 / 2, rounded
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -50,11 +52,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 3;
+pub const LIBRARY_VERSION: u8 = 4;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 6;
-/// Bytes per action in a version 2 shape table (no turn, no still share).
+pub const SHAPE_BYTES: usize = 7;
+/// Bytes per action in a version 2 shape table (no turn, no still share, no height).
 const SHAPE_BYTES_V2: usize = 4;
+/// Bytes per action in a version 3 shape table (no height).
+const SHAPE_BYTES_V3: usize = 6;
 /// The largest `ln(1 + angle turned)` the shape table holds (about 8.5 turns).
 pub const SHAPE_TURN_MAX: f32 = 4.0;
 /// Library blob header size, bytes.
@@ -63,7 +67,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (11,848).
+/// Largest valid library blob, bytes (11,880).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -215,8 +219,8 @@ pub struct Library<'a> {
     bytes: &'a [u8],
     n: usize,
     offsets: [u16; MAX_ACTIONS],
-    /// Offset of the shape table (0: none — a version 1 blob, or a version 2 one, whose
-    /// shapes lack two dimensions and are not used).
+    /// Offset of the shape table (0: none — a version 1 blob, or a version 2 or 3 one, whose
+    /// shapes lack dimensions and are not used).
     shapes: u16,
 }
 
@@ -269,6 +273,7 @@ impl<'a> Library<'a> {
         let stride = match version {
             1 => 0,
             2 => SHAPE_BYTES_V2,
+            3 => SHAPE_BYTES_V3,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -295,20 +300,21 @@ impl<'a> Library<'a> {
         })
     }
 
-    /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2
-    /// library's shapes lack two dimensions and are not used).
+    /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2 or
+    /// 3 library's shapes lack dimensions and are not used).
     pub fn shape(&self, i: usize) -> Option<Shape> {
         if self.shapes == 0 || i >= self.n {
             return None;
         }
         let at = usize::from(self.shapes) + SHAPE_BYTES * i;
         match *self.bytes.get(at..at + SHAPE_BYTES)? {
-            [l, u, f, 1..=255, t, s] => Some([
+            [l, u, f, 1..=255, t, s, h] => Some([
                 f32::from(l) / 255.0,
                 f32::from(u) / 255.0,
                 f32::from(f) / 255.0,
                 f32::from(t) * (SHAPE_TURN_MAX / 255.0),
                 f32::from(s) / 255.0,
+                f32::from(h) * (2.0 / 255.0) - 1.0,
             ]),
             _ => None,
         }
@@ -496,12 +502,12 @@ pub(crate) mod tests {
     }
 
     /// `blob` (version 1) as the current version with a shape table (`None`: unknown).
-    pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 5]>]) -> Vec<u8> {
+    pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 6]>]) -> Vec<u8> {
         let mut out = blob.to_vec();
         out[3] = LIBRARY_VERSION;
         for s in shapes {
             match s {
-                Some([l, u, f, t, st]) => out.extend([*l, *u, *f, 1, *t, *st]),
+                Some([l, u, f, t, st, h]) => out.extend([*l, *u, *f, 1, *t, *st, *h]),
                 None => out.extend([0; SHAPE_BYTES]),
             }
         }
@@ -513,47 +519,53 @@ pub(crate) mod tests {
         let v1 = seq_library(&[(&["u", "d"], 0), (&["f", "b"], 0)]);
         let old = Library::from_bytes(&v1).unwrap();
         assert_eq!((old.len(), old.shape(0)), (2, None));
-        let v3 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255]), None]);
-        let lib = Library::from_bytes(&v3).unwrap();
-        let near = |a: Option<Shape>, b: [f32; 5]| {
-            a.is_some_and(|a| (0..5).all(|k| (a[k] - b[k]).abs() < 1e-6))
+        let v4 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255, 153]), None]);
+        let lib = Library::from_bytes(&v4).unwrap();
+        let near = |a: Option<Shape>, b: Shape| {
+            a.is_some_and(|a| (0..6).all(|k| (a[k] - b[k]).abs() < 1e-6))
         };
-        assert!(near(lib.shape(0), [0.0, 1.0, 0.2, 0.8, 1.0]));
+        let want = [0.0, 1.0, 0.2, 0.8, 1.0, 0.2];
+        assert!(near(lib.shape(0), want), "{:?}", lib.shape(0));
         assert_eq!(lib.shape(1), None);
         assert_eq!(lib.shape(2), None);
         assert_eq!(lib.pattern(1).unwrap().positions(), 2);
         assert_eq!((lib.shape_spread(0), lib.shape_spread(1)), (0.0, 0.0));
         // The flag byte also carries how far the examples' shapes spread: 1 + 51 → 51 / 254.
-        let mut spread = v3.clone();
+        let mut spread = v4.clone();
         let flag = spread.len() - 2 * SHAPE_BYTES + 3;
         spread[flag] = 1 + 51;
         let lib = Library::from_bytes(&spread).unwrap();
-        assert!(near(lib.shape(0), [0.0, 1.0, 0.2, 0.8, 1.0]));
+        assert!(near(lib.shape(0), want));
         assert_eq!(lib.shape_spread(0), 51.0 / 254.0);
         // A missing or partial table, a known shape without its flag, stray bytes after an
         // unknown shape.
         assert_eq!(
-            Library::from_bytes(&v3[..v3.len() - 1]).err(),
+            Library::from_bytes(&v4[..v4.len() - 1]).err(),
             Some(Error::Truncated)
         );
-        let mut bad = v3.clone();
+        let mut bad = v4.clone();
         bad[flag] = 0;
         assert!(Library::from_bytes(&bad).is_err());
-        let mut bad = v3.clone();
+        let mut bad = v4.clone();
         let last = bad.len() - 2;
         bad[last] = 7;
         assert!(Library::from_bytes(&bad).is_err());
-        // Version 2: four bytes per entry; its patterns load, its shapes (which lack the
-        // turn and the still share) are not used.
-        let mut v2 = v1.clone();
-        v2[3] = 2;
-        v2.extend([0, 255, 51, 52, 0, 0, 0, 0]);
-        let lib = Library::from_bytes(&v2).unwrap();
-        assert_eq!((lib.len(), lib.shape(0)), (2, None));
-        assert_eq!(lib.pattern(1).unwrap().positions(), 2);
-        let mut v4 = v3.clone();
-        v4[3] = 4;
-        assert_eq!(Library::from_bytes(&v4).err(), Some(Error::Version(4)));
+        // Versions 2 and 3: four and six bytes per entry; their patterns load, their shapes
+        // (which lack the turn and the still share, or the height) are not used.
+        for (version, entry) in [(2u8, &[0u8, 255, 51, 52][..]), (3, &[0, 255, 51, 52, 9, 9])] {
+            let mut old = v1.clone();
+            old[3] = version;
+            old.extend(entry);
+            old.extend(core::iter::repeat_n(0, entry.len()));
+            let lib = Library::from_bytes(&old).unwrap();
+            assert_eq!((lib.len(), lib.shape(0)), (2, None), "version {version}");
+            assert_eq!(lib.pattern(1).unwrap().positions(), 2);
+            old.push(0);
+            assert!(Library::from_bytes(&old).is_err(), "version {version}");
+        }
+        let mut v5 = v4.clone();
+        v5[3] = 5;
+        assert_eq!(Library::from_bytes(&v5).err(), Some(Error::Version(5)));
     }
 
     #[test]

@@ -716,17 +716,23 @@ mod tests {
         // Without shapes the tie goes to the lower index.
         assert_eq!(actions(&v1), [0]);
         // Shares of speed (× 255): left, up, front; then the turn and the still share, none
-        // here. The hop is the bob's, whichever its index.
-        let skim = Some([0, 50, 250, 0, 0]);
-        let bob = Some([0, 150, 200, 0, 0]);
+        // here; then the height, an arc's (the mean height above the start is about a third
+        // of the path: (1 + 0.32) × 255 / 2 ≈ 168). The hop is the bob's, whichever its index.
+        let skim = Some([0, 50, 250, 0, 0, 168]);
+        let bob = Some([0, 150, 200, 0, 0, 168]);
         let with = crate::pattern::tests::with_shapes;
         assert_eq!(actions(&with(&v1, &[skim, bob])), [1]);
         assert_eq!(actions(&with(&v1, &[bob, skim])), [0]);
         // Two bobs, one of which turns (ln(1 + angle) = 4 × 100 / 255 ≈ 1.6, a turn of about
         // 3.8 rad) and holds a third of its time: the hop, which does neither, is the other's.
-        let twisting = Some([0, 150, 200, 100, 85]);
+        let twisting = Some([0, 150, 200, 100, 85, 168]);
         assert_eq!(actions(&with(&v1, &[twisting, bob])), [1]);
         assert_eq!(actions(&with(&v1, &[bob, twisting])), [0]);
+        // Two bobs, one of which stays below where it began (a crouch's height, −0.2): the
+        // hop, which rises, is the other's.
+        let low = Some([0, 150, 200, 0, 0, 102]);
+        assert_eq!(actions(&with(&v1, &[low, bob])), [1]);
+        assert_eq!(actions(&with(&v1, &[bob, low])), [0]);
     }
 
     #[test]

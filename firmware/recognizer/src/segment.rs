@@ -39,8 +39,11 @@ pub const SHAPE_CAP: i16 = 4;
 /// Weight of each [`Shape`] dimension in [`shape_distance`]: the shares of speed as they are;
 /// the log angle turned and the still share scaled so that what tells actions apart in them
 /// (a throw turns about twice as far as a kick; a crouch spends half its time held, a jump a
-/// fifth) weighs about as much as a walk's bob against a run's skim does in the shares.
-pub const SHAPE_SCALE: Shape = [1.0, 1.0, 1.0, 0.5, 0.5];
+/// fifth) weighs about as much as a walk's bob against a run's skim does in the shares; the
+/// height ×3, as one action's performances vary about a third as much in it (±0.04 of the
+/// path, against ±0.11 in a share of speed), and a crouch, about −0.3, and a jump, about
+/// +0.07, are written alike.
+pub const SHAPE_SCALE: Shape = [1.0, 1.0, 1.0, 0.5, 0.5, 3.0];
 
 /// Weighted distance between two shapes ([`SHAPE_SCALE`]); NaN when either has a NaN.
 pub fn shape_distance(a: &Shape, b: &Shape) -> f32 {
@@ -306,8 +309,8 @@ mod tests {
 
     #[test]
     fn a_shape_unlike_the_actions_costs_up_to_one_token() {
-        let walk = [0.1, 0.55, 0.75, 0.3, 0.2];
-        let like = |l: f32, u: f32, f: f32| [l, u, f, 0.3, 0.2];
+        let walk = [0.1, 0.55, 0.75, 0.3, 0.2, 0.02];
+        let like = |l: f32, u: f32, f: f32| [l, u, f, 0.3, 0.2, 0.02];
         assert_eq!(shape_penalty(walk, 0.0, walk), 0);
         // A run's flatter strides: 0.3 less up, 0.1 more front → 50 × 0.1 = 5 → capped at 4.
         assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.25, 0.85)), SHAPE_CAP);
@@ -320,10 +323,23 @@ mod tests {
         // 0.8 apart, weighed 0.5 → 50 × 0.4² = 8 → capped; held 0.4 longer (weighed 0.5) →
         // 50 × 0.2² = 2.
         assert_eq!(
-            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 1.1, 0.2]),
+            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 1.1, 0.2, 0.02]),
             SHAPE_CAP
         );
-        assert_eq!(shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.6]), 2);
+        assert_eq!(
+            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.6, 0.02]),
+            2
+        );
+        // Lower on average by 0.1 of the path (a crouch for a jump), weighed 3 → 50 × 0.3² =
+        // 4.5 → capped; by 0.04 → 50 × 0.12² = 0.72 → nothing.
+        assert_eq!(
+            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.2, -0.08]),
+            SHAPE_CAP
+        );
+        assert_eq!(
+            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.2, -0.02]),
+            0
+        );
         // Where the examples lay up to 0.1 away, only what lies beyond counts: 50 × 0.1² = 0.5
         // → nothing; 50 × 0.2² = 2.
         assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.45, 0.75)), 0);

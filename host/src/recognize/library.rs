@@ -50,6 +50,11 @@ pub struct ActionEntry {
     /// examples; absent in a library learnt before they were measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_turn_still: Option<[f32; 2]>,
+    /// The examples' mean height above where they began as a share of their path length
+    /// (world up; positive for a jump, negative for a crouch), averaged over the examples;
+    /// absent in a library learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_height: Option<f32>,
     /// How far the examples' own shapes lie from their mean (the largest
     /// `figurine_recognizer::segment::shape_distance`): a match whose shape lies as close
     /// costs no merit. A kick flicked flat or high varies where a walk's hops do not.
@@ -137,6 +142,7 @@ impl ActionEntry {
             examples,
             shape: None,
             shape_turn_still: None,
+            shape_height: None,
             shape_spread: None,
         };
         let c = Regex::parse(regex)?.compile()?;
@@ -145,13 +151,14 @@ impl ActionEntry {
         Ok(e)
     }
 
-    /// The same entry with motion shape `shape` (see [`ActionEntry::shape`] and
-    /// [`ActionEntry::shape_turn_still`]).
+    /// The same entry with motion shape `shape` (see [`ActionEntry::shape`],
+    /// [`ActionEntry::shape_turn_still`] and [`ActionEntry::shape_height`]).
     pub fn with_shape(mut self, shape: Option<Shape>) -> Self {
         self.shape = shape.map(|s| [s[0], s[1], s[2]]);
         self.shape_turn_still = shape
             .map(|s| [s[3], s[4]])
             .filter(|t| t.iter().all(|x| x.is_finite()));
+        self.shape_height = shape.map(|s| s[5]).filter(|h| h.is_finite());
         self
     }
 
@@ -159,7 +166,8 @@ impl ActionEntry {
     pub fn full_shape(&self) -> Option<Shape> {
         let [l, u, f] = self.shape?;
         let [t, s] = self.shape_turn_still.unwrap_or([f32::NAN; 2]);
-        Some([l, u, f, t, s])
+        let h = self.shape_height.unwrap_or(f32::NAN);
+        Some([l, u, f, t, s, h])
     }
 
     /// The same entry with shape spread `spread` (see [`ActionEntry::shape_spread`]).
@@ -169,8 +177,9 @@ impl ActionEntry {
     }
 
     /// The device's shape-table entry (layout in `figurine_recognizer::pattern`); all zero
-    /// when there is no shape. A shape learnt before the turn and still share were measured
-    /// has none: the device would read zeros as a gesture that neither turns nor holds.
+    /// when there is no shape. A shape learnt before the turn, the still share and the height
+    /// were measured has none: the device would read zeros as a gesture that neither turns
+    /// nor holds, or a height of −1.
     fn shape_bytes(&self) -> [u8; SHAPE_BYTES] {
         match self.full_shape() {
             Some(s) if s.iter().all(|x| x.is_finite()) => {
@@ -184,6 +193,7 @@ impl ActionEntry {
                     k,
                     q(s[3] / SHAPE_TURN_MAX),
                     q(s[4]),
+                    q((s[5] + 1.0) / 2.0),
                 ]
             }
             _ => [0; SHAPE_BYTES],
@@ -317,7 +327,7 @@ mod tests {
     #[test]
     fn a_learnt_shape_reaches_the_device_and_a_hand_written_pattern_has_none() {
         let mut lib = LibraryFile::default();
-        let shape = [0.05, 0.6, 0.8, 1.2, 0.3];
+        let shape = [0.05, 0.6, 0.8, 1.2, 0.3, -0.25];
         let hop = ActionEntry::new("hop", "(uf df)+", None, vec![])
             .unwrap()
             .with_shape(Some(shape))
@@ -327,7 +337,7 @@ mod tests {
         let blob = lib.blob().unwrap();
         let dev = Library::from_bytes(&blob).unwrap();
         let s = dev.shape(0).unwrap();
-        let step = [1.0, 1.0, 1.0, SHAPE_TURN_MAX, 1.0];
+        let step = [1.0, 1.0, 1.0, SHAPE_TURN_MAX, 1.0, 2.0];
         for ((got, want), k) in s.iter().zip(shape).zip(step) {
             assert!((got - want).abs() <= 0.5 * k / 255.0 + 1e-6, "{s:?}");
         }
@@ -341,8 +351,12 @@ mod tests {
         assert_eq!(back.actions[0].full_shape(), Some(shape));
         assert_eq!(back.actions[0].shape_spread, Some(0.1));
         assert_eq!(back.actions[1].shape, None);
-        // A library learnt before the turn and the still share were measured keeps its three
-        // shares in the JSON, but the device gets no shape rather than a wrong one.
+        // A library learnt before the turn and the still share, or the height, were measured
+        // keeps what it has in the JSON, but the device gets no shape rather than a wrong one.
+        let mut no_height = back.clone();
+        no_height.actions[0].shape_height = None;
+        let dev_blob = no_height.blob().unwrap();
+        assert_eq!(Library::from_bytes(&dev_blob).unwrap().shape(0), None);
         back.actions[0].shape_turn_still = None;
         let dev_blob = back.blob().unwrap();
         assert_eq!(Library::from_bytes(&dev_blob).unwrap().shape(0), None);

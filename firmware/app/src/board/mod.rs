@@ -1,7 +1,7 @@
 //! The board: serial link, clock, flash. Exactly one board module is compiled, chosen by
 //! cargo feature (`qemu`, the default, or `nrf52840`). Each provides the same items:
 //!
-//! * `NAME`, `init() -> Board` (peripherals, time driver, logging);
+//! * `NAME`, `init() -> Board` (peripherals, stopwatch, logging);
 //! * `SerialRx::read` / `SerialTx::write_all` (async byte link to the host);
 //! * `Flash` (an `embedded_storage` `NorFlash`) with `LIBRARY_STORE` / `EFFORT_STORE`
 //!   slot layouts inside it and `mapped_flash` to read a stored blob in place;
@@ -9,7 +9,7 @@
 
 use figurine_store::TwoSlotStore;
 
-/// Bytes of one library slot: the recognizer's largest library (11,848 B) + header, in
+/// Bytes of one library slot: the recognizer's largest library (11,880 B) + header, in
 /// whole 4 KiB pages.
 pub const LIBRARY_SLOT: u32 = 16 * 1024;
 /// Bytes of one effort-model slot (largest model 560 B + header).

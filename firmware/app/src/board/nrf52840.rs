@@ -2,7 +2,8 @@
 //!
 //! * link: UARTE0 at 1 Mbaud, RX P1.12 / TX P1.11 (XIAO pins D7 / D6), DMA-buffered
 //!   (`BufferedUarte`, [`RX_BUFFER`]/[`TX_BUFFER`] bytes); see `hw/README.md` for wiring;
-//! * clock: RTC1 as the embassy time driver; DWT cycle counter as the stopwatch (64 MHz);
+//! * clock: the DWT cycle counter as the stopwatch (64 MHz); no time driver (nothing waits on
+//!   a clock: samples carry their own time);
 //! * flash: the NVMC over the STORE region of the root `memory.x` (64 KiB at 0xF_0000);
 //! * logs: defmt over RTT (probe-rs); a panic logs its location and halts on `UDF`.
 
@@ -133,7 +134,7 @@ pub fn mapped_flash(offset: u32, len: u32) -> &'static [u8] {
     unsafe { core::slice::from_raw_parts((STORE_BASE as usize + offset) as *const u8, len) }
 }
 
-/// Brings up the board: clocks and RTC1 time driver, the cycle counter, UARTE0, the NVMC.
+/// Brings up the board: clocks, the cycle counter, UARTE0, the NVMC.
 pub fn init() -> Board {
     let p = embassy_nrf::init(Default::default());
     if let Some(mut core) = cortex_m::Peripherals::take() {

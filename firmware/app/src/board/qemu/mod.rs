@@ -1,7 +1,8 @@
 //! QEMU `mps2-an386` (Cortex-M4F at 25 MHz), run by `qemu-system-arm -M mps2-an386`.
 //!
 //! * link: CMSDK APB UART0, interrupt-driven ([`uart`]);
-//! * clock: SysTick as the embassy time driver (`systick-timer`), also the cycle stopwatch;
+//! * clock: SysTick, free-running, as the cycle stopwatch; no time driver (nothing waits on a
+//!   clock: samples carry their own time);
 //! * flash: RAM-backed NOR emulation with power-cut injection ([`flash`]);
 //! * logs: defmt over semihosting; a panic exits QEMU with status 101 (semihosting `exit`).
 //!
@@ -11,8 +12,8 @@ mod flash;
 mod uart;
 mod vectors;
 
+use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
-use systick_timer::SystickDriver;
 
 pub use flash::{mapped_flash, Flash, STORE_SIZE};
 pub use uart::{SerialRx, SerialTx};
@@ -31,14 +32,6 @@ pub const CORE_HZ: u32 = 25_000_000;
 const SYSTICK_RELOAD: u32 = 0x00FF_FFFF;
 /// Semihosting command-line buffer, bytes.
 const ARGS_BUF: usize = 256;
-
-embassy_time_driver::time_driver_impl!(static DRIVER: SystickDriver<4>
-    = SystickDriver::new(CORE_HZ as u64, SYSTICK_RELOAD));
-
-#[cortex_m_rt::exception]
-fn SysTick() {
-    DRIVER.systick_interrupt();
-}
 
 /// Counts core clock cycles over an interval shorter than one SysTick wrap (0.67 s).
 /// Under `qemu-system-arm -icount shift=0` one instruction takes 1 ns of virtual time, so
@@ -74,13 +67,17 @@ fn fault_from_args() -> Option<flash::Cut> {
     cut
 }
 
-/// Brings up the board: time driver, UART0 with its interrupts, the RAM-backed flash.
+/// Brings up the board: the SysTick stopwatch, UART0 with its interrupts, the RAM-backed flash.
 pub fn init() -> Board {
     let Some(mut core) = cortex_m::Peripherals::take() else {
         // Only reachable if init ran twice.
         semihosting::process::exit(102)
     };
-    DRIVER.start(&mut core.SYST);
+    // Counting down from the full 24 bits at the core clock, without an interrupt.
+    core.SYST.set_clock_source(SystClkSource::Core);
+    core.SYST.set_reload(SYSTICK_RELOAD);
+    core.SYST.clear_current();
+    core.SYST.enable_counter();
     let (rx, tx) = uart::init(&mut core.NVIC);
     let flash = Flash::new(fault_from_args());
     if let Some(c) = flash.armed() {
