@@ -15,6 +15,15 @@
 //! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example);
 //! otherwise nothing is reported.
 //!
+//! A phrase that some action's pattern could still go on from is no gesture of its own while
+//! the figurine rests (it may be holding inside that action), but it is once the stream ends
+//! or the rest outlasts every hold ([`OPEN_PHRASE_US`]): a sudden sidestep whose landings the
+//! smoothing took is still a sidestep.
+//!
+//! The same loose reading settles a match the automata did make but whose motion is plainly
+//! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
+//! same tokens and its examples moved as the match did, that action it is.
+//!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
 //! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
 //! away), and so does the end of a log (the recognizer's `flush`); a match too brief to be an
@@ -25,8 +34,8 @@ use crate::alignment::{weighted_cost, FULL};
 use crate::automaton::prefix_alive;
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
-use crate::recognizer::shape_of;
-use crate::segment::{Candidate, EDIT_SHARE, HOLD_US};
+use crate::recognizer::{observed_shape, penalty_of, shape_of};
+use crate::segment::{Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US, SHAPE_CAP};
 use crate::token::{Token, STILL};
 
 /// Longest phrase that is compared with the actions, moving tokens; a longer one is no single
@@ -110,14 +119,16 @@ pub fn nearest_action(
     floor: u32,
     bounds: bool,
     last: u32,
+    closed: bool,
 ) -> Option<Nearest> {
     let mut tok = [STILL; NEAREST_MAX_TOKENS];
     let (n, first, last) = phrase(hist, floor, bounds, last, &mut tok)?;
     let tokens = tok.get(..n).unwrap_or(&[]);
     // A phrase some action could still go on from is no gesture of its own: nothing to weigh.
-    if (0..lib.len())
-        .filter_map(|a| lib.pattern(a))
-        .any(|p| prefix_alive(&p, tokens, false))
+    if !closed
+        && (0..lib.len())
+            .filter_map(|a| lib.pattern(a))
+            .any(|p| prefix_alive(&p, tokens, false))
     {
         return Some(Nearest {
             candidate: None,
@@ -171,11 +182,82 @@ pub fn nearest_action(
     })
 }
 
-/// Whether runs `first..=last` moved as action `a`'s examples did: it has a shape, and
-/// theirs lies within its spread ([`shape_of`] charges nothing).
+/// Whether runs `first..=last` moved as action `a`'s examples did: the action has a shape,
+/// and the runs' shape lies within its tolerances ([`shape_of`] charges nothing).
 fn shape_agrees(lib: &Library<'_>, a: usize, hist: &History, first: u32, last: u32) -> bool {
-    lib.shape(a).is_some() && shape_of(lib, a, hist, first, last) == 0
+    shape_of(lib, a, hist, first, last) == Some(0)
 }
+
+/// Another reading of candidate `c` (its runs `c.start..=c.end`, at most
+/// [`NEAREST_MAX_TOKENS`] moving ones) when its motion shape is as unlike its action's
+/// examples' as [`shape_penalty`](crate::segment::shape_penalty) measures ([`SHAPE_CAP`]):
+/// the action whose pattern reads the same tokens within [`LOOSE_SHARE`] and whose examples'
+/// shape the motion lies within (nearest by cost per aligned token, then the lower index).
+/// None when there is none, or `c`'s shape is not that unlike. The automata hold every match
+/// to [`EDIT_SHARE`], so a performance that lost a stroke its action's examples all had (a
+/// sudden jump's flight, too quick for the smoothing, read as a crouch's `d u`) may be matched
+/// only by an action it plainly did not move like; the shape then decides, as it does for a
+/// stand-alone phrase.
+// Once per committed event, when its shape is unlike: out of the per-sample path (flash).
+#[cold]
+#[inline(never)]
+pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candidate> {
+    let observed = observed_shape(hist, c.start, c.end);
+    if penalty_of(lib, usize::from(c.action), &observed) != Some(SHAPE_CAP) {
+        return None;
+    }
+    let mut tok = [STILL; NEAREST_MAX_TOKENS];
+    let mut n = 0usize;
+    let mut i = c.start;
+    for _ in 0..HISTORY_RUNS {
+        let r = hist.get(i)?;
+        if r.token != STILL {
+            *tok.get_mut(n)? = r.token;
+            n += 1;
+        }
+        if i == c.end {
+            break;
+        }
+        i = i.wrapping_add(1);
+    }
+    let tokens = tok.get(..n)?;
+    let mut best: Option<(Candidate, usize)> = None;
+    for a in 0..lib.len() {
+        // The shape first: it is cheaper than the alignment, and most actions fail it.
+        if a == usize::from(c.action) || penalty_of(lib, a, &observed) != Some(0) {
+            continue;
+        }
+        let Some(p) = lib.pattern(a) else { continue };
+        let aligned = n.max(p.min_len());
+        let (e, t) = LOOSE_SHARE;
+        let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
+        let Some(cost) = weighted_cost(&p, tokens, bound) else {
+            continue;
+        };
+        let nearer = best.is_none_or(|(b, b_aligned)| {
+            usize::from(cost) * b_aligned < usize::from(b.cost) * aligned
+        });
+        if nearer {
+            let alt = Candidate {
+                action: a as u8,
+                cost,
+                min_len: p.min_len().min(255) as u8,
+                positions: p.positions().min(255) as u8,
+                cyclic: p.cyclic(),
+                shape: 0,
+                ..*c
+            };
+            best = Some((alt, aligned));
+        }
+    }
+    best.map(|(b, _)| b)
+}
+
+/// Stillness after which a phrase that some action's pattern could still go on from stands
+/// alone all the same, µs: no action holds that long inside itself (the longest hold the
+/// decider waits for, [`crate::segment::GAPPED_HOLD_US`]) — a sudden sidestep's hops that
+/// read only as rising, whose landing the smoothing took, are a sidestep, not half of one.
+pub const OPEN_PHRASE_US: u64 = GAPPED_HOLD_US;
 
 /// Edits per token a stand-alone phrase may be off its nearest action when no other action
 /// is as near and its shape is the action's ([`nearest_action`]), as (edits, tokens).
@@ -186,8 +268,9 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::alignment::HALF;
-    use crate::features::Accum;
+    use crate::features::{Accum, Shape, ShapeSums, QUANTITIES, SPEED};
     use crate::pattern::tests::seq_library;
+    use crate::segment::shape_cost;
     use crate::token::parse_token;
 
     /// A history of runs `(token, duration ms)` ("_" for STILL), back to back from t = 0.
@@ -222,7 +305,7 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         // A punch without its wind-up: one deletion in three aligned tokens.
         let h = history(&[("_", 800), ("f", 200), ("b", 200), ("_", 150)]);
-        let n = nearest_action(&lib, &h, 0, false, 2).unwrap();
+        let n = nearest_action(&lib, &h, 0, false, 2, false).unwrap();
         let c = n.candidate.unwrap();
         assert_eq!(
             (c.action, c.start, c.end, c.distance(), c.cost),
@@ -237,7 +320,7 @@ mod tests {
             ("db", 200),
             ("_", 150),
         ]);
-        let c = nearest_action(&lib, &h, 0, false, 3)
+        let c = nearest_action(&lib, &h, 0, false, 3, false)
             .unwrap()
             .candidate
             .unwrap();
@@ -245,7 +328,9 @@ mod tests {
         // Without its drop back as well, it is too far: 1.5 edits in 3 aligned tokens.
         let h = history(&[("_", 800), ("f.Xn", 200), ("b.Xp", 200), ("_", 150)]);
         assert_eq!(
-            nearest_action(&lib, &h, 0, false, 2).unwrap().candidate,
+            nearest_action(&lib, &h, 0, false, 2, false)
+                .unwrap()
+                .candidate,
             None
         );
         // … unless the kick's examples left a shape the phrase moves like (these runs carry
@@ -253,7 +338,7 @@ mod tests {
         // share: then it is the kick.
         let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 0, 255, 0, 0, 128]); 3]);
         let with_shapes = Library::from_bytes(&shaped).unwrap();
-        let c = nearest_action(&with_shapes, &h, 0, false, 2)
+        let c = nearest_action(&with_shapes, &h, 0, false, 2, false)
             .unwrap()
             .candidate
             .unwrap();
@@ -268,7 +353,11 @@ mod tests {
         let blob = lib_blob();
         let shaped = crate::pattern::tests::with_shapes(&blob, &[shape; 3]);
         let lib = Library::from_bytes(&shaped).unwrap();
-        let found = |lib: &Library<'_>| nearest_action(lib, &h, 0, false, 1).unwrap().candidate;
+        let found = |lib: &Library<'_>| {
+            nearest_action(lib, &h, 0, false, 1, false)
+                .unwrap()
+                .candidate
+        };
         assert_eq!(found(&lib).map(|c| c.action), Some(1));
         // Without a shape learnt for it: nothing.
         let unshaped = crate::pattern::tests::with_shapes(&blob, &[shape, None, shape]);
@@ -291,12 +380,33 @@ mod tests {
         // Nothing like any action.
         let h = history(&[("_", 800), ("l", 200), ("r", 200), ("l", 200), ("_", 150)]);
         assert_eq!(
-            nearest_action(&lib, &h, 0, false, 3).unwrap().candidate,
+            nearest_action(&lib, &h, 0, false, 3, false)
+                .unwrap()
+                .candidate,
             None
         );
         // A crouch's way down, held: the crouch may still rise.
         let h = history(&[("_", 800), ("d", 300), ("_", 150)]);
-        assert!(nearest_action(&lib, &h, 0, false, 1).unwrap().open);
+        assert!(nearest_action(&lib, &h, 0, false, 1, false).unwrap().open);
+        // Once the phrase is closed (the stream ended, or no hold lasts that long) it is
+        // weighed like any other: a lone `d` is a whole edit from the crouch in two aligned
+        // tokens, beyond the share without a shape …
+        let closed = nearest_action(&lib, &h, 0, false, 1, true).unwrap();
+        assert!(!closed.open);
+        assert_eq!(closed.candidate, None);
+        // … and the crouch within the loose share when its examples' shape is the phrase's.
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 255, 0, 0, 0, 128]); 3]);
+        let shaped = Library::from_bytes(&shaped).unwrap();
+        assert!(
+            nearest_action(&shaped, &h, 0, false, 1, false)
+                .unwrap()
+                .open
+        );
+        let c = nearest_action(&shaped, &h, 0, false, 1, true)
+            .unwrap()
+            .candidate
+            .unwrap();
+        assert_eq!((c.action, c.start, c.end, c.cost), (1, 1, 1, FULL));
         // A pause shorter than a hold lies inside the phrase, which reaches the floor there.
         let h = history(&[
             ("_", 800),
@@ -306,16 +416,131 @@ mod tests {
             ("b", 200),
             ("_", 150),
         ]);
-        assert_eq!(nearest_action(&lib, &h, 3, false, 4), None);
-        let c = nearest_action(&lib, &h, 0, false, 4)
+        assert_eq!(nearest_action(&lib, &h, 3, false, 4, false), None);
+        let c = nearest_action(&lib, &h, 0, false, 4, false)
             .unwrap()
             .candidate
             .unwrap();
         assert_eq!((c.action, c.start, c.end, c.cost), (0, 1, 4, 0));
         // The last run below the floor (committed), or no motion at all.
-        assert_eq!(nearest_action(&lib, &h, 5, false, 4), None);
+        assert_eq!(nearest_action(&lib, &h, 5, false, 4, false), None);
         let h = history(&[("_", 800), ("_", 150)]);
-        assert_eq!(nearest_action(&lib, &h, 0, false, 0), None);
+        assert_eq!(nearest_action(&lib, &h, 0, false, 0, false), None);
+    }
+
+    /// A history of moving runs `(token, ticks, |velocity| along left/up/front m/s, rise per
+    /// tick m)` back to back after 800 ms of stillness, and the shape of those runs.
+    fn moved(runs: &[(&str, u32, [f32; 3], f32)]) -> (History, Shape) {
+        let mut h = history(&[("_", 800)]);
+        let mut sums = ShapeSums::new();
+        let mut t = 800_000u64;
+        for (i, &(name, ticks, v, rise)) in runs.iter().enumerate() {
+            let mut q = [0.0; QUANTITIES];
+            q[..3].copy_from_slice(&v);
+            q[SPEED] = crate::fmath::norm3(v);
+            let mut acc = Accum::new();
+            for _ in 0..ticks {
+                acc.add(&q, rise);
+            }
+            sums.add(&acc, false);
+            h.open(parse_token(name).unwrap(), (i as u32 + 1, t), acc);
+            t += u64::from(ticks) * 10_000;
+            h.newest_mut().unwrap().end = (i as u32 + 1, t);
+        }
+        (h, sums.shape())
+    }
+
+    /// A shape as the shape table holds it ([`crate::pattern::tests::with_shapes`]).
+    fn shape_bytes(s: Shape) -> [u8; 6] {
+        let q = |x: f32| (x * 255.0 + 0.5) as u8;
+        [
+            q(s[0]),
+            q(s[1]),
+            q(s[2]),
+            q(s[3] / crate::pattern::SHAPE_TURN_MAX),
+            q(s[4]),
+            q((s[5] + 1.0) / 2.0),
+        ]
+    }
+
+    #[test]
+    fn a_match_unlike_its_action_is_reread_as_the_near_action_it_moved_like() {
+        // A jump whose flight the tokens lost (`d u`): it rose well above where it began.
+        let (h, rose) = moved(&[
+            ("d", 10, [0.0, 0.8, 0.1], -0.002),
+            ("u", 20, [0.0, 0.9, 0.3], 0.012),
+        ]);
+        assert!(rose[5] > 0.1, "{rose:?}");
+        // 0: crouch `d+ u+`, held low (height −0.3); 1: jump `d+ u+ uf+ df+`, shaped as this.
+        let blob = seq_library(&[(&["d", "u"], 1), (&["d", "u", "uf", "df"], 1)]);
+        let mut crouch = rose;
+        crouch[5] = -0.3;
+        let shaped = crate::pattern::tests::with_shapes(
+            &blob,
+            &[Some(shape_bytes(crouch)), Some(shape_bytes(rose))],
+        );
+        let lib = Library::from_bytes(&shaped).unwrap();
+        assert_eq!(shape_of(&lib, 0, &h, 1, 2), Some(SHAPE_CAP));
+        assert_eq!(shape_of(&lib, 1, &h, 1, 2), Some(0));
+        let c = Candidate {
+            action: 0,
+            start: 1,
+            end: 2,
+            cost: 0,
+            len: 2,
+            min_len: 2,
+            positions: 2,
+            cyclic: false,
+            shape: SHAPE_CAP,
+        };
+        // The flight's `uf df` left out: within two whole edits in four aligned tokens, the
+        // loose share.
+        let r = reread(&lib, &h, &c).unwrap();
+        assert_eq!(
+            (r.action, r.start, r.end, r.min_len, r.shape),
+            (1, 1, 2, 4, 0)
+        );
+        assert!(
+            r.cost <= 2 * FULL
+                && r.cost
+                    == weighted_cost(
+                        &lib.pattern(1).unwrap(),
+                        &[parse_token("d").unwrap(), parse_token("u").unwrap()],
+                        255
+                    )
+                    .unwrap()
+        );
+        // The runs' shape decides, not what the candidate was charged (a nearest action's
+        // candidate carries none).
+        assert_eq!(reread(&lib, &h, &Candidate { shape: 0, ..c }), Some(r));
+        // Not when no other action's examples moved like it, nor when the other action is
+        // further than the loose share.
+        let unlike = crate::pattern::tests::with_shapes(
+            &blob,
+            &[Some(shape_bytes(crouch)), Some(shape_bytes(crouch))],
+        );
+        assert_eq!(reread(&Library::from_bytes(&unlike).unwrap(), &h, &c), None);
+        let far = seq_library(&[(&["d", "u"], 1), (&["d", "u", "l", "r", "l", "r"], 1)]);
+        let far = crate::pattern::tests::with_shapes(
+            &far,
+            &[Some(shape_bytes(crouch)), Some(shape_bytes(rose))],
+        );
+        assert_eq!(reread(&Library::from_bytes(&far).unwrap(), &h, &c), None);
+        // Nor when the crouch's own shape is only a little off.
+        let mut near = rose;
+        near[5] -= 0.05;
+        let mild = crate::pattern::tests::with_shapes(
+            &blob,
+            &[Some(shape_bytes(near)), Some(shape_bytes(rose))],
+        );
+        let mild = Library::from_bytes(&mild).unwrap();
+        let penalty = shape_of(&mild, 0, &h, 1, 2).unwrap();
+        assert!((1..SHAPE_CAP).contains(&penalty));
+        let mild_c = Candidate {
+            shape: shape_cost(penalty, 2),
+            ..c
+        };
+        assert_eq!(reread(&mild, &h, &mild_c), None);
     }
 
     #[test]
@@ -324,16 +549,16 @@ mod tests {
         let lib = Library::from_bytes(&blob).unwrap();
         // Played right away: less stillness before the punch than a hold.
         let h = history(&[("_", 300), ("f", 200), ("b", 200), ("_", 150)]);
-        let c = nearest_action(&lib, &h, 0, true, 2)
+        let c = nearest_action(&lib, &h, 0, true, 2, false)
             .unwrap()
             .candidate
             .unwrap();
         assert_eq!((c.action, c.start, c.end, c.cost), (0, 1, 2, FULL));
         // The same runs after an event that ended at the floor: not a whole phrase.
-        assert_eq!(nearest_action(&lib, &h, 0, false, 2), None);
+        assert_eq!(nearest_action(&lib, &h, 0, false, 2, false), None);
         // The stream began in motion: the phrase starts with it.
         let h = history(&[("f", 200), ("b", 200), ("_", 150)]);
-        let c = nearest_action(&lib, &h, 0, true, 1)
+        let c = nearest_action(&lib, &h, 0, true, 1, false)
             .unwrap()
             .candidate
             .unwrap();
@@ -349,7 +574,7 @@ mod tests {
         runs.push(("_", 150));
         let h = history(&runs);
         assert_eq!(
-            nearest_action(&lib, &h, 0, false, (NEAREST_MAX_TOKENS + 1) as u32),
+            nearest_action(&lib, &h, 0, false, (NEAREST_MAX_TOKENS + 1) as u32, false),
             None
         );
     }

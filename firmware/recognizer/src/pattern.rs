@@ -8,9 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (4; versions 3 and 2, whose shape tables have only the
-//!         first 6 and 4 bytes of each entry, and version 1, without the table, are still
-//!         read — their shapes are not used)
+//! 0   4   magic "FGL" + version byte (5; versions 4, 3 and 2, whose shape tables have only
+//!         the first 7, 6 and 4 bytes of each entry, and version 1, without the table, are
+//!         still read — their shapes are not used)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
 //! 5   3   reserved, zero
 //! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
@@ -25,23 +25,24 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 7 bytes per action in record order (the mean of its examples'
-//! shapes, `features::Shape`):
+//! then the shape table, 13 bytes per action in record order (the mean of its examples'
+//! shapes, `features::Shape`, and how far they lay from it):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
-//! +3  1   0 = shape unknown (all seven bytes are zero); else shape known (learnt from
-//!         examples), and 1 + 254 × how far the examples' shapes lay from it (the largest
-//!         `segment::shape_distance`, rounded; 1 = the examples agree, or a library from
-//!         before the spread)
+//! +3  1   0 = shape unknown (all thirteen bytes are zero); otherwise shape known (learnt
+//!         from examples; the host writes 1)
 //! +4  1   ln(1 + angle turned, rad) × 255 / SHAPE_TURN_MAX, rounded
 //! +5  1   share of the time spent still × 255, rounded
 //! +6  1   (1 + mean height above the start as a share of the path length) × 255 / 2, rounded
+//! +7  6   tolerance of each of the six dimensions above, in their order: the largest
+//!         `segment::SHAPE_SCALE`-weighted |example − mean| (at least the learner's floor),
+//!         × 255 rounded, at most 255
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
 //! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
 
-use crate::features::Shape;
+use crate::features::{Shape, SHAPE_DIMS};
 use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
 use crate::Error;
 
@@ -52,9 +53,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 4;
+pub const LIBRARY_VERSION: u8 = 5;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 7;
+pub const SHAPE_BYTES: usize = 13;
+/// Bytes per action in a version 4 shape table (one spread for all dimensions).
+const SHAPE_BYTES_V4: usize = 7;
+/// Offset of the tolerances in a shape-table entry.
+const SHAPE_TOLERANCE_AT: usize = 7;
 /// Bytes per action in a version 2 shape table (no turn, no still share, no height).
 const SHAPE_BYTES_V2: usize = 4;
 /// Bytes per action in a version 3 shape table (no height).
@@ -67,7 +72,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (11,880).
+/// Largest valid library blob, bytes (12,072).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -274,6 +279,7 @@ impl<'a> Library<'a> {
             1 => 0,
             2 => SHAPE_BYTES_V2,
             3 => SHAPE_BYTES_V3,
+            4 => SHAPE_BYTES_V4,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -300,15 +306,15 @@ impl<'a> Library<'a> {
         })
     }
 
-    /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2 or
-    /// 3 library's shapes lack dimensions and are not used).
+    /// The motion shape of action `i` ([`Shape`]) when it was learnt with one (a version 2, 3
+    /// or 4 library's shapes lack dimensions or tolerances and are not used).
     pub fn shape(&self, i: usize) -> Option<Shape> {
         if self.shapes == 0 || i >= self.n {
             return None;
         }
         let at = usize::from(self.shapes) + SHAPE_BYTES * i;
         match *self.bytes.get(at..at + SHAPE_BYTES)? {
-            [l, u, f, 1..=255, t, s, h] => Some([
+            [l, u, f, 1..=255, t, s, h, ..] => Some([
                 f32::from(l) / 255.0,
                 f32::from(u) / 255.0,
                 f32::from(f) / 255.0,
@@ -320,17 +326,21 @@ impl<'a> Library<'a> {
         }
     }
 
-    /// How far the examples' shapes of action `i` lay from [`Library::shape`] (the largest
-    /// distance, in shares of speed; 0 when not known).
-    pub fn shape_spread(&self, i: usize) -> f32 {
+    /// How far the examples' shapes of action `i` lay from [`Library::shape`], per dimension
+    /// ([`crate::segment::shape_penalty`]'s tolerance: `segment::SHAPE_SCALE`-weighted
+    /// |example − mean|, in the shape's units); all 0 when its shape is not known.
+    pub fn shape_tolerance(&self, i: usize) -> Shape {
+        let mut out = [0.0; SHAPE_DIMS];
         if self.shapes == 0 || i >= self.n {
-            return 0.0;
+            return out;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i + 3;
-        match self.bytes.get(at) {
-            Some(&k) if k > 1 => f32::from(k - 1) / 254.0,
-            _ => 0.0,
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_TOLERANCE_AT;
+        if let Some(bytes) = self.bytes.get(at..at + SHAPE_DIMS) {
+            for (t, &b) in out.iter_mut().zip(bytes) {
+                *t = f32::from(b) / 255.0;
+            }
         }
+        out
     }
 
     /// Number of actions.
@@ -501,13 +511,17 @@ pub(crate) mod tests {
         out
     }
 
-    /// `blob` (version 1) as the current version with a shape table (`None`: unknown).
+    /// `blob` (version 1) as the current version with a shape table (`None`: unknown), each
+    /// known shape with tolerance 0 in every dimension.
     pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 6]>]) -> Vec<u8> {
         let mut out = blob.to_vec();
         out[3] = LIBRARY_VERSION;
         for s in shapes {
             match s {
-                Some([l, u, f, t, st, h]) => out.extend([*l, *u, *f, 1, *t, *st, *h]),
+                Some([l, u, f, t, st, h]) => {
+                    out.extend([*l, *u, *f, 1, *t, *st, *h]);
+                    out.extend([0; SHAPE_DIMS]);
+                }
                 None => out.extend([0; SHAPE_BYTES]),
             }
         }
@@ -519,8 +533,8 @@ pub(crate) mod tests {
         let v1 = seq_library(&[(&["u", "d"], 0), (&["f", "b"], 0)]);
         let old = Library::from_bytes(&v1).unwrap();
         assert_eq!((old.len(), old.shape(0)), (2, None));
-        let v4 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255, 153]), None]);
-        let lib = Library::from_bytes(&v4).unwrap();
+        let v5 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255, 153]), None]);
+        let lib = Library::from_bytes(&v5).unwrap();
         let near = |a: Option<Shape>, b: Shape| {
             a.is_some_and(|a| (0..6).all(|k| (a[k] - b[k]).abs() < 1e-6))
         };
@@ -529,43 +543,52 @@ pub(crate) mod tests {
         assert_eq!(lib.shape(1), None);
         assert_eq!(lib.shape(2), None);
         assert_eq!(lib.pattern(1).unwrap().positions(), 2);
-        assert_eq!((lib.shape_spread(0), lib.shape_spread(1)), (0.0, 0.0));
-        // The flag byte also carries how far the examples' shapes spread: 1 + 51 → 51 / 254.
-        let mut spread = v4.clone();
-        let flag = spread.len() - 2 * SHAPE_BYTES + 3;
-        spread[flag] = 1 + 51;
-        let lib = Library::from_bytes(&spread).unwrap();
+        assert_eq!(lib.shape_tolerance(0), [0.0; 6]);
+        assert_eq!(lib.shape_tolerance(1), [0.0; 6]);
+        // The tolerances follow the shape, one byte per dimension: 51 → 0.2.
+        let mut tol = v5.clone();
+        let entry = tol.len() - 2 * SHAPE_BYTES;
+        tol[entry + SHAPE_TOLERANCE_AT + 1] = 51;
+        tol[entry + SHAPE_TOLERANCE_AT + 5] = 255;
+        let lib = Library::from_bytes(&tol).unwrap();
         assert!(near(lib.shape(0), want));
-        assert_eq!(lib.shape_spread(0), 51.0 / 254.0);
+        assert_eq!(lib.shape_tolerance(0), [0.0, 0.2, 0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(lib.shape_tolerance(2), [0.0; 6]);
         // A missing or partial table, a known shape without its flag, stray bytes after an
         // unknown shape.
         assert_eq!(
-            Library::from_bytes(&v4[..v4.len() - 1]).err(),
+            Library::from_bytes(&v5[..v5.len() - 1]).err(),
             Some(Error::Truncated)
         );
-        let mut bad = v4.clone();
-        bad[flag] = 0;
+        let mut bad = tol.clone();
+        bad[entry + 3] = 0;
         assert!(Library::from_bytes(&bad).is_err());
-        let mut bad = v4.clone();
+        let mut bad = v5.clone();
         let last = bad.len() - 2;
         bad[last] = 7;
         assert!(Library::from_bytes(&bad).is_err());
-        // Versions 2 and 3: four and six bytes per entry; their patterns load, their shapes
-        // (which lack the turn and the still share, or the height) are not used.
-        for (version, entry) in [(2u8, &[0u8, 255, 51, 52][..]), (3, &[0, 255, 51, 52, 9, 9])] {
+        // Versions 2, 3 and 4: four, six and seven bytes per entry; their patterns load,
+        // their shapes (which lack the turn and the still share, the height, or a tolerance
+        // per dimension) are not used.
+        for (version, entry) in [
+            (2u8, &[0u8, 255, 51, 52][..]),
+            (3, &[0, 255, 51, 52, 9, 9]),
+            (4, &[0, 255, 51, 52, 9, 9, 128]),
+        ] {
             let mut old = v1.clone();
             old[3] = version;
             old.extend(entry);
             old.extend(core::iter::repeat_n(0, entry.len()));
             let lib = Library::from_bytes(&old).unwrap();
             assert_eq!((lib.len(), lib.shape(0)), (2, None), "version {version}");
+            assert_eq!(lib.shape_tolerance(0), [0.0; 6]);
             assert_eq!(lib.pattern(1).unwrap().positions(), 2);
             old.push(0);
             assert!(Library::from_bytes(&old).is_err(), "version {version}");
         }
-        let mut v5 = v4.clone();
-        v5[3] = 5;
-        assert_eq!(Library::from_bytes(&v5).err(), Some(Error::Version(5)));
+        let mut v6 = v5.clone();
+        v6[3] = 6;
+        assert_eq!(Library::from_bytes(&v6).err(), Some(Error::Version(6)));
     }
 
     #[test]

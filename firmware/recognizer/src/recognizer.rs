@@ -15,7 +15,7 @@ use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
-use crate::nearest::{nearest_action, Nearest};
+use crate::nearest::{nearest_action, reread, Nearest, OPEN_PHRASE_US};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, CONTINUE_US,
@@ -226,10 +226,12 @@ impl<'lib> Recognizer<'lib> {
                 // if near (once per pause).
                 let idle = self.decider.pending().is_none() && self.provisional.is_none();
                 if let (true, true, Some(run)) = (still >= PAUSE_US, idle, newest) {
+                    let closed = still >= OPEN_PHRASE_US;
                     let found = match self.nearest {
-                        Some((r, n)) if r == run => n,
+                        // Weighed again once, when the pause closes an open phrase.
+                        Some((r, n)) if r == run && !(closed && n.is_some_and(|n| n.open)) => n,
                         _ => {
-                            let n = self.nearest_to(run.wrapping_sub(1));
+                            let n = self.nearest_to(run.wrapping_sub(1), closed);
                             self.nearest = Some((run, n));
                             n
                         }
@@ -357,7 +359,7 @@ impl<'lib> Recognizer<'lib> {
             if let Some(Nearest {
                 candidate: Some(c),
                 open: false,
-            }) = self.nearest_to(last)
+            }) = self.nearest_to(last, true)
             {
                 self.commit(c, &mut emit);
             }
@@ -368,9 +370,16 @@ impl<'lib> Recognizer<'lib> {
     /// [`nearest_action`] for the phrase ending at run `last`, from where a phrase may begin.
     // Two call sites, once per pause and at the end: inlined, as the call was (flash).
     #[inline(always)]
-    fn nearest_to(&self, last: u32) -> Option<Nearest> {
+    fn nearest_to(&self, last: u32, closed: bool) -> Option<Nearest> {
         let (floor, bounds) = self.phrase_floor;
-        nearest_action(&self.library, self.front.history(), floor, bounds, last)
+        nearest_action(
+            &self.library,
+            self.front.history(),
+            floor,
+            bounds,
+            last,
+            closed,
+        )
     }
 
     /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.
@@ -478,7 +487,10 @@ impl<'lib> Recognizer<'lib> {
                 min_len: p.min_len().min(255) as u8,
                 positions: p.positions().min(255) as u8,
                 cyclic: p.cyclic(),
-                shape: shape_cost(shape_of(&self.library, a, hist, start, end), j + 1),
+                shape: shape_cost(
+                    shape_of(&self.library, a, hist, start, end).unwrap_or(0),
+                    j + 1,
+                ),
             };
             if best.is_none_or(|b| c.beats(&b)) {
                 best = Some(c);
@@ -581,11 +593,16 @@ impl<'lib> Recognizer<'lib> {
     /// Commits a candidate and emits it: as a new event, as the continuation of the held
     /// cyclic one (the next cycle after a short pause), or as the revision of the provisional
     /// report of another candidate it took over (nothing, when it is that reported candidate).
-    /// A cyclic action's event stays held so that its next cycle can continue it.
+    /// A cyclic action's event stays held so that its next cycle can continue it. A candidate
+    /// whose shape is as unlike its action's as the penalty measures is first offered to
+    /// [`reread`].
     fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
         // After a provisional report, `c` is judged against what the consumer had before it:
         // the held event as it was, if the report continued it; nothing, if the report was a
         // new event (which `c` replaces).
+        // A match whose motion is plainly unlike its action's is read as the action whose
+        // pattern nearly fits it and whose examples moved as it did, if one does.
+        let c = reread(&self.library, self.front.history(), &c).unwrap_or(c);
         let provisional = self.provisional.take();
         let before = match provisional {
             Some((_, held, true)) => held,
@@ -620,7 +637,7 @@ impl<'lib> Recognizer<'lib> {
     }
 }
 
-/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); 0
+/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); None
 /// when the library has no shape for it.
 // Once per candidate, not per sample: one out-of-line copy (flash).
 #[inline(never)]
@@ -630,19 +647,25 @@ pub(crate) fn shape_of(
     hist: &History,
     start: u32,
     end: u32,
-) -> i16 {
-    match library.shape(a) {
-        Some(expected) => shape_penalty(
-            expected,
-            library.shape_spread(a),
-            observed_shape(hist, start, end),
-        ),
-        None => 0,
-    }
+) -> Option<i16> {
+    penalty_of(library, a, &observed_shape(hist, start, end))
+}
+
+/// The shape penalty of action `a` for motion of shape `observed` ([`shape_penalty`]); None
+/// when the library has no shape for it.
+// Once per candidate and per action a match is re-read as: one out-of-line copy (flash).
+#[inline(never)]
+pub(crate) fn penalty_of(library: &Library<'_>, a: usize, observed: &Shape) -> Option<i16> {
+    let expected = library.shape(a)?;
+    Some(shape_penalty(
+        expected,
+        library.shape_tolerance(a),
+        *observed,
+    ))
 }
 
 /// The motion shape of runs `start..=end` ([`Shape`]), the holds between them included.
-fn observed_shape(hist: &History, start: u32, end: u32) -> Shape {
+pub(crate) fn observed_shape(hist: &History, start: u32, end: u32) -> Shape {
     let mut sums = ShapeSums::new();
     let mut i = start;
     for _ in 0..HISTORY_RUNS {
@@ -782,6 +805,49 @@ mod tests {
         let blob = seq_library(&[(&["l", "r"], 0), (&["b", "d"], 0)]);
         let lib = Library::from_bytes(&blob).unwrap();
         assert_eq!(run(&lib, &hops(1, 0)), []);
+    }
+
+    #[test]
+    fn a_phrase_an_action_could_go_on_from_is_weighed_once_it_cannot() {
+        // One hop (`u uf f df`) of a pattern that goes on `b` after it: while the figurine rests,
+        // the hop may be the start of that action; once the stream ends, or the rest outlasts
+        // any hold, it is a whole gesture, a stroke short of the action.
+        let blob = seq_library(&[(&["l", "r"], 0), (&["u", "uf", "f", "df", "b"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let hop = hops(1, 0);
+        let ev = run(&lib, &hop);
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert_eq!((ev[0].action, ev[0].distance), (1, 1));
+        // Live, with the rest going on: nothing yet after a second of it; the nearest action
+        // once it has lasted OPEN_PHRASE_US.
+        let last = *hop.last().unwrap();
+        let rest = |s: f32| -> Vec<Sample> {
+            let mut out = hop.clone();
+            let n = (s * 120.0) as u32;
+            out.extend((1..=n).map(|i| Sample {
+                seq: last.seq + i,
+                t_us: last.t_us + u64::from(i) * 1_000_000 / 120,
+                ..last
+            }));
+            out
+        };
+        let live = |samples: &[Sample]| {
+            let mut rec = Recognizer::new(lib, None);
+            let mut ev = Vec::new();
+            for s in samples {
+                rec.push(s, |e| ev.push(e));
+            }
+            ev
+        };
+        assert_eq!(live(&rest(0.4)), []);
+        let ev = live(&rest(2.0));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert_eq!(ev[0].action, 1);
+        let after = ev[0].decided_us - ev[0].end_us;
+        assert!(
+            (OPEN_PHRASE_US..OPEN_PHRASE_US + 100_000).contains(&after),
+            "{after}"
+        );
     }
 
     /// `hops` hops forward (as [`hops`]), each pair of hops separated by `pause_s` of stillness.

@@ -26,7 +26,7 @@
 //! has paused after it.
 
 use crate::alignment::FULL;
-use crate::features::Shape;
+use crate::features::{Shape, SHAPE_DIMS};
 use crate::fmath;
 
 /// Quarter tokens of merit per squared share of speed by which a match's motion shape
@@ -36,7 +36,7 @@ pub const SHAPE_WEIGHT: f32 = 50.0;
 /// decide, the shape only tips near-ties.
 pub const SHAPE_CAP: i16 = 4;
 
-/// Weight of each [`Shape`] dimension in [`shape_distance`]: the shares of speed as they are;
+/// Weight of each [`Shape`] dimension in [`shape_penalty`]: the shares of speed as they are;
 /// the log angle turned and the still share scaled so that what tells actions apart in them
 /// (a throw turns about twice as far as a kick; a crouch spends half its time held, a jump a
 /// fifth) weighs about as much as a walk's bob against a run's skim does in the shares; the
@@ -45,29 +45,28 @@ pub const SHAPE_CAP: i16 = 4;
 /// +0.07, are written alike.
 pub const SHAPE_SCALE: Shape = [1.0, 1.0, 1.0, 0.5, 0.5, 3.0];
 
-/// Weighted distance between two shapes ([`SHAPE_SCALE`]); NaN when either has a NaN.
-pub fn shape_distance(a: &Shape, b: &Shape) -> f32 {
-    let mut d2 = 0.0;
-    for ((x, y), w) in a.iter().zip(b.iter()).zip(SHAPE_SCALE.iter()) {
-        d2 += w * w * (x - y) * (x - y);
-    }
-    fmath::sqrt(d2)
-}
-
 /// The merit (quarter tokens) a match loses when its motion shape `observed` is unlike its
-/// action's `expected` one: [`SHAPE_WEIGHT`] × the squared [`shape_distance`] beyond
-/// `spread` (how far the action's own examples lay from `expected`), at most [`SHAPE_CAP`].
+/// action's `expected` one: [`SHAPE_WEIGHT`] × the sum over the dimensions of the squared
+/// weighted difference ([`SHAPE_SCALE`] × |observed − expected|) beyond that dimension's
+/// `tolerance` (how far the action's own examples lay from `expected` in it, weighted alike),
+/// at most [`SHAPE_CAP`]. A dimension that is NaN on either side (no evidence) counts nothing.
 /// Tokens only know which way each stroke went, to 45°; the shape keeps how much: a walk's
 /// hops bob, a run's strides skim, though both are written `uf f df`. Where the examples
-/// themselves varied (a kick flicked flat or high), so may a performance, at no cost.
-pub fn shape_penalty(expected: Shape, spread: f32, observed: Shape) -> i16 {
-    let d = shape_distance(&expected, &observed);
-    if !fmath::is_finite(d) || d <= spread {
-        // A degenerate shape (no evidence either way), or one as close as the examples'.
+/// themselves varied (a kick flicked flat or high), so may a performance, at no cost — in that
+/// dimension only: a walk whose examples turned more or less does not thereby skim like a run.
+pub fn shape_penalty(expected: Shape, tolerance: Shape, observed: Shape) -> i16 {
+    let mut d2 = 0.0;
+    for k in 0..SHAPE_DIMS {
+        let beyond = SHAPE_SCALE[k] * fmath::abs(observed[k] - expected[k]) - tolerance[k];
+        // False for NaN too.
+        if beyond > 0.0 {
+            d2 += beyond * beyond;
+        }
+    }
+    if !fmath::is_finite(d2) {
         return 0;
     }
-    let beyond = d - spread;
-    fmath::min(SHAPE_WEIGHT * beyond * beyond, f32::from(SHAPE_CAP)) as i16
+    fmath::min(SHAPE_WEIGHT * d2, f32::from(SHAPE_CAP)) as i16
 }
 
 /// Tokens of a match over which a shape unlike its action's costs up to [`SHAPE_CAP`] once
@@ -307,44 +306,54 @@ mod tests {
         }
     }
 
+    const EXACT: Shape = [0.0; SHAPE_DIMS];
+
     #[test]
     fn a_shape_unlike_the_actions_costs_up_to_one_token() {
         let walk = [0.1, 0.55, 0.75, 0.3, 0.2, 0.02];
         let like = |l: f32, u: f32, f: f32| [l, u, f, 0.3, 0.2, 0.02];
-        assert_eq!(shape_penalty(walk, 0.0, walk), 0);
+        assert_eq!(shape_penalty(walk, EXACT, walk), 0);
         // A run's flatter strides: 0.3 less up, 0.1 more front → 50 × 0.1 = 5 → capped at 4.
-        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.25, 0.85)), SHAPE_CAP);
+        assert_eq!(shape_penalty(walk, EXACT, like(0.1, 0.25, 0.85)), SHAPE_CAP);
         // A little off: 50 × 0.04² ≈ 0.08 → nothing.
-        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.51, 0.75)), 0);
+        assert_eq!(shape_penalty(walk, EXACT, like(0.1, 0.51, 0.75)), 0);
         // 50 × 0.2² = 2 quarter tokens.
-        assert_eq!(shape_penalty(walk, 0.0, like(0.1, 0.35, 0.75)), 2);
-        assert_eq!(shape_penalty(walk, 0.0, like(f32::NAN, 0.5, 0.7)), 0);
+        assert_eq!(shape_penalty(walk, EXACT, like(0.1, 0.35, 0.75)), 2);
+        assert_eq!(shape_penalty(walk, EXACT, like(f32::NAN, 0.5, 0.7)), 0);
         // The same strokes, turning much further (a throw's swing for a kick's lean): ln-angle
         // 0.8 apart, weighed 0.5 → 50 × 0.4² = 8 → capped; held 0.4 longer (weighed 0.5) →
         // 50 × 0.2² = 2.
         assert_eq!(
-            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 1.1, 0.2, 0.02]),
+            shape_penalty(walk, EXACT, [0.1, 0.55, 0.75, 1.1, 0.2, 0.02]),
             SHAPE_CAP
         );
         assert_eq!(
-            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.6, 0.02]),
+            shape_penalty(walk, EXACT, [0.1, 0.55, 0.75, 0.3, 0.6, 0.02]),
             2
         );
         // Lower on average by 0.1 of the path (a crouch for a jump), weighed 3 → 50 × 0.3² =
         // 4.5 → capped; by 0.04 → 50 × 0.12² = 0.72 → nothing.
         assert_eq!(
-            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.2, -0.08]),
+            shape_penalty(walk, EXACT, [0.1, 0.55, 0.75, 0.3, 0.2, -0.08]),
             SHAPE_CAP
         );
         assert_eq!(
-            shape_penalty(walk, 0.0, [0.1, 0.55, 0.75, 0.3, 0.2, -0.02]),
+            shape_penalty(walk, EXACT, [0.1, 0.55, 0.75, 0.3, 0.2, -0.02]),
             0
         );
         // Where the examples lay up to 0.1 away, only what lies beyond counts: 50 × 0.1² = 0.5
         // → nothing; 50 × 0.2² = 2.
-        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.45, 0.75)), 0);
-        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.35, 0.75)), 0);
-        assert_eq!(shape_penalty(walk, 0.1, like(0.1, 0.25, 0.75)), 2);
+        let tenth = [0.1; SHAPE_DIMS];
+        assert_eq!(shape_penalty(walk, tenth, like(0.1, 0.45, 0.75)), 0);
+        assert_eq!(shape_penalty(walk, tenth, like(0.1, 0.35, 0.75)), 0);
+        assert_eq!(shape_penalty(walk, tenth, like(0.1, 0.25, 0.75)), 2);
+        // Per dimension: examples that turned more or less excuse turning, not skimming.
+        let turned = [0.0, 0.0, 0.0, 0.5, 0.0, 0.0];
+        assert_eq!(
+            shape_penalty(walk, turned, [0.1, 0.55, 0.75, 1.1, 0.2, 0.02]),
+            0
+        );
+        assert_eq!(shape_penalty(walk, turned, like(0.1, 0.35, 0.75)), 2);
         // Taken off the merit: an exact tie goes to the matching shape.
         let a = Candidate {
             shape: 0,

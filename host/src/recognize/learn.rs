@@ -36,7 +36,7 @@ use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::features::{Accum, Shape, ShapeSums, ANGVEL, SPEED};
 use figurine_recognizer::history::Run;
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
-use figurine_recognizer::segment::{edits_fit, shape_distance};
+use figurine_recognizer::segment::{edits_fit, SHAPE_SCALE};
 use figurine_recognizer::token::{
     mirror_token, symbol_matches, token_from_signs, token_signs, Symbol, Token, ANY_LIN, ANY_ROT,
     NONE_BIN, STILL, TURN,
@@ -137,19 +137,29 @@ fn shape_of_runs(g: &[Run]) -> Option<Shape> {
 }
 
 /// The motion shapes of the examples that moved ([`motion_shape`]), read once for
-/// [`mean_shape`] and [`shape_spread`].
+/// [`mean_shape`] and [`shape_tolerance`].
 pub fn example_shapes(logs: &[PoseLog]) -> Vec<Shape> {
     logs.iter().filter_map(motion_shape).collect()
 }
 
-/// How far the shapes lie from their mean ([`mean_shape`]): the largest
-/// [`shape_distance`] of one from it. None without shapes.
-pub fn shape_spread(shapes: &[Shape]) -> Option<f32> {
+/// Least tolerance of a shape dimension ([`shape_tolerance`]), in its weighted units (a share
+/// of speed): a few examples that happened to agree closely in a dimension still leave some
+/// room for the next performance.
+pub const SHAPE_TOLERANCE_FLOOR: f32 = 0.06;
+
+/// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the largest
+/// |shape − mean|, weighted by `SHAPE_SCALE` as the device weighs it
+/// (`figurine_recognizer::segment::shape_penalty`), at least [`SHAPE_TOLERANCE_FLOOR`].
+/// None without shapes.
+pub fn shape_tolerance(shapes: &[Shape]) -> Option<Shape> {
     let mean = mean_shape(shapes)?;
-    shapes
-        .iter()
-        .map(|s| shape_distance(&mean, s))
-        .reduce(f32::max)
+    Some(core::array::from_fn(|k| {
+        let far = shapes
+            .iter()
+            .map(|s| (s[k] - mean[k]).abs())
+            .fold(0.0f32, f32::max);
+        (SHAPE_SCALE[k] * far).max(SHAPE_TOLERANCE_FLOOR)
+    }))
 }
 
 /// The mean of motion shapes ([`example_shapes`]); None without shapes.
@@ -876,7 +886,7 @@ pub fn learn_action(
         examples,
     )?
     .with_shape(mean_shape(&shapes))
-    .with_shape_spread(shape_spread(&shapes));
+    .with_shape_tolerance(shape_tolerance(&shapes));
     Ok(entry)
 }
 
@@ -1026,7 +1036,7 @@ mod tests {
         }
         // No motion, no shape.
         assert_eq!(mean_shape(&[]), None);
-        assert_eq!(shape_spread(&[]), None);
+        assert_eq!(shape_tolerance(&[]), None);
     }
 
     #[test]
@@ -1078,14 +1088,24 @@ mod tests {
 
     #[test]
     fn a_kick_flicked_flat_or_high_spreads_its_shape_more_than_a_walk() {
-        let spread = |action: Action, seed: u64| {
-            shape_spread(&example_shapes(&example_logs(action, seed))).unwrap()
+        // Up share (dimension 1), over a few example sets: a kick's flick rises 0.3–1.4× as
+        // far as it goes forward, a walk's hops bob alike.
+        let up = |action: Action, seed: u64| {
+            shape_tolerance(&example_shapes(&example_logs(action, seed))).unwrap()[1]
         };
-        // Over a few example sets: a kick's flick rises 0.3–1.4× as far as it goes forward.
-        let kick: f32 = (1..=4).map(|s| spread(Action::Kick, s)).sum();
-        let walk: f32 = (1..=4).map(|s| spread(Action::Walk, s)).sum();
+        let kick: f32 = (1..=4).map(|s| up(Action::Kick, s)).sum();
+        let walk: f32 = (1..=4).map(|s| up(Action::Walk, s)).sum();
         assert!(kick > walk, "kick {kick} walk {walk}");
-        assert!(walk >= 0.0);
+        // Each dimension on its own, weighted as the device weighs it, never below the floor.
+        let shapes = [
+            [0.1, 0.5, 0.8, 1.0, 0.2, 0.0],
+            [0.1, 0.7, 0.6, 1.4, 0.2, 0.1],
+        ];
+        let tol = shape_tolerance(&shapes).unwrap();
+        let want = [0.06, 0.1, 0.1, 0.1, 0.06, 0.15];
+        for (got, want) in tol.iter().zip(want) {
+            assert!((got - want).abs() < 1e-6, "{tol:?}");
+        }
     }
 
     /// Whether `re` accepts the token string `tokens` (names separated by spaces) exactly.

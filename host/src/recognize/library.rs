@@ -55,10 +55,16 @@ pub struct ActionEntry {
     /// absent in a library learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_height: Option<f32>,
-    /// How far the examples' own shapes lie from their mean (the largest
-    /// `figurine_recognizer::segment::shape_distance`): a match whose shape lies as close
-    /// costs no merit. A kick flicked flat or high varies where a walk's hops do not.
+    /// How far the examples' own shapes lie from their mean in each dimension of
+    /// `figurine_recognizer::features::Shape` (`learn::shape_tolerance`: the largest weighted
+    /// difference, at least a floor): a match whose shape lies as close in a dimension costs
+    /// no merit for it. A kick flicked flat or high varies where a walk's hops do not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_tolerance: Option<[f32; 6]>,
+    /// How far the examples' shapes lay from their mean as one distance: what a library
+    /// learnt before [`ActionEntry::shape_tolerance`] holds. Read, never written: it stands
+    /// for the tolerance of every dimension.
+    #[serde(default, skip_serializing)]
     pub shape_spread: Option<f32>,
 }
 
@@ -143,6 +149,7 @@ impl ActionEntry {
             shape: None,
             shape_turn_still: None,
             shape_height: None,
+            shape_tolerance: None,
             shape_spread: None,
         };
         let c = Regex::parse(regex)?.compile()?;
@@ -170,10 +177,20 @@ impl ActionEntry {
         Some([l, u, f, t, s, h])
     }
 
-    /// The same entry with shape spread `spread` (see [`ActionEntry::shape_spread`]).
-    pub fn with_shape_spread(mut self, spread: Option<f32>) -> Self {
-        self.shape_spread = spread;
+    /// The same entry with shape tolerance `tolerance` (see
+    /// [`ActionEntry::shape_tolerance`]).
+    pub fn with_shape_tolerance(mut self, tolerance: Option<[f32; 6]>) -> Self {
+        self.shape_tolerance = tolerance;
+        self.shape_spread = None;
         self
+    }
+
+    /// The tolerance of each shape dimension: as learnt, or a library's older single spread
+    /// in every dimension, or none (0).
+    pub fn tolerance(&self) -> [f32; 6] {
+        self.shape_tolerance
+            .or_else(|| self.shape_spread.map(|s| [s; 6]))
+            .unwrap_or([0.0; 6])
     }
 
     /// The device's shape-table entry (layout in `figurine_recognizer::pattern`); all zero
@@ -184,16 +201,23 @@ impl ActionEntry {
         match self.full_shape() {
             Some(s) if s.iter().all(|x| x.is_finite()) => {
                 let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
-                let spread = self.shape_spread.filter(|x| x.is_finite()).unwrap_or(0.0);
-                let k = 1 + (spread.clamp(0.0, 1.0) * 254.0).round() as u8;
+                let tol = self
+                    .tolerance()
+                    .map(|x| if x.is_finite() { x } else { 0.0 });
                 [
                     q(s[0]),
                     q(s[1]),
                     q(s[2]),
-                    k,
+                    1,
                     q(s[3] / SHAPE_TURN_MAX),
                     q(s[4]),
                     q((s[5] + 1.0) / 2.0),
+                    q(tol[0]),
+                    q(tol[1]),
+                    q(tol[2]),
+                    q(tol[3]),
+                    q(tol[4]),
+                    q(tol[5]),
                 ]
             }
             _ => [0; SHAPE_BYTES],
@@ -331,7 +355,7 @@ mod tests {
         let hop = ActionEntry::new("hop", "(uf df)+", None, vec![])
             .unwrap()
             .with_shape(Some(shape))
-            .with_shape_spread(Some(0.1));
+            .with_shape_tolerance(Some([0.06, 0.1, 0.06, 0.2, 0.06, 0.5]));
         lib.upsert(hop);
         lib.upsert(ActionEntry::new("slide", "l+ r+ l+", Some(1), vec![]).unwrap());
         let blob = lib.blob().unwrap();
@@ -342,15 +366,36 @@ mod tests {
             assert!((got - want).abs() <= 0.5 * k / 255.0 + 1e-6, "{s:?}");
         }
         assert_eq!(dev.shape(1), None);
-        assert!((dev.shape_spread(0) - 0.1).abs() <= 0.5 / 254.0 + 1e-6);
-        assert_eq!(dev.shape_spread(1), 0.0);
+        let tol = dev.shape_tolerance(0);
+        for (got, want) in tol.iter().zip([0.06, 0.1, 0.06, 0.2, 0.06, 0.5]) {
+            assert!((got - want).abs() <= 0.5 / 255.0 + 1e-6, "{tol:?}");
+        }
+        assert_eq!(dev.shape_tolerance(1), [0.0; 6]);
         // The JSON keeps it; an entry without one writes no `shape` at all.
         let text = serde_json::to_string(&lib).unwrap();
         assert_eq!(text.matches("\"shape\"").count(), 1, "{text}");
+        assert!(!text.contains("shape_spread"), "{text}");
         let mut back = LibraryFile::from_json(&text).unwrap();
         assert_eq!(back.actions[0].full_shape(), Some(shape));
-        assert_eq!(back.actions[0].shape_spread, Some(0.1));
+        assert_eq!(
+            back.actions[0].shape_tolerance,
+            Some([0.06, 0.1, 0.06, 0.2, 0.06, 0.5])
+        );
         assert_eq!(back.actions[1].shape, None);
+        // A library learnt with one spread for all dimensions: it stands for each.
+        let old = text.replace(
+            "\"shape_tolerance\":[0.06,0.1,0.06,0.2,0.06,0.5]",
+            "\"shape_spread\":0.2",
+        );
+        assert_ne!(old, text);
+        let old = LibraryFile::from_json(&old).unwrap();
+        assert_eq!(old.actions[0].tolerance(), [0.2; 6]);
+        let dev_blob = old.clone().blob().unwrap();
+        let tol = Library::from_bytes(&dev_blob).unwrap().shape_tolerance(0);
+        assert!(
+            tol.iter().all(|t| (t - 0.2).abs() <= 0.5 / 255.0),
+            "{tol:?}"
+        );
         // A library learnt before the turn and the still share, or the height, were measured
         // keeps what it has in the JSON, but the device gets no shape rather than a wrong one.
         let mut no_height = back.clone();

@@ -197,8 +197,10 @@ fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
     )
     .ok()
     .map(|e| {
-        e.with_shape(entry.full_shape())
-            .with_shape_spread(entry.shape_spread)
+        let mut e = e.with_shape(entry.full_shape());
+        e.shape_tolerance = entry.shape_tolerance;
+        e.shape_spread = entry.shape_spread;
+        e
     })
 }
 
