@@ -193,12 +193,12 @@ fn shape_agrees(lib: &Library<'_>, a: usize, hist: &History, first: u32, last: u
 /// examples' as [`shape_penalty`](crate::segment::shape_penalty) measures ([`SHAPE_CAP`]):
 /// the action whose pattern reads the same tokens within [`LOOSE_SHARE`] and whose examples'
 /// shape the motion lies within (nearest by cost per aligned token, then the lower index).
-/// None when there is none, or `c`'s shape is not that unlike. The automata hold every match
+/// None when there is none, or the runs' shape is not that unlike. The automata hold every match
 /// to [`EDIT_SHARE`], so a performance that lost a stroke its action's examples all had (a
 /// sudden jump's flight, too quick for the smoothing, read as a crouch's `d u`) may be matched
 /// only by an action it plainly did not move like; the shape then decides, as it does for a
 /// stand-alone phrase.
-// Once per committed event, when its shape is unlike: out of the per-sample path (flash).
+// Once per committed event, not per sample: out of the per-sample path (flash).
 #[cold]
 #[inline(never)]
 pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candidate> {
