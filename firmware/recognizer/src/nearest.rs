@@ -138,31 +138,11 @@ pub fn nearest_action(
     let mut best: Option<(Candidate, usize)> = None;
     let mut loose = 0usize;
     for a in 0..lib.len() {
-        let Some(p) = lib.pattern(a) else { continue };
-        let aligned = n.max(p.min_len());
-        // Within the loose share: cost ≤ FULL · aligned · e / t half-edits.
-        let (e, t) = LOOSE_SHARE;
-        let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
-        let Some(cost) = weighted_cost(&p, tokens, bound) else {
+        let Some((c, aligned)) = loose_reading(lib, a, tokens, first, last) else {
             continue;
         };
         loose += 1;
-        let c = Candidate {
-            action: a as u8,
-            start: first,
-            end: last,
-            cost,
-            len: n as u16,
-            min_len: p.min_len().min(255) as u8,
-            positions: p.positions().min(255) as u8,
-            cyclic: p.cyclic(),
-            shape: 0,
-        };
-        // Lower cost per aligned token: c.cost / aligned < b.cost / b_aligned.
-        let better = best.is_none_or(|(b, b_aligned)| {
-            usize::from(c.cost) * b_aligned < usize::from(b.cost) * aligned
-        });
-        if better {
+        if nearer(&c, aligned, best) {
             best = Some((c, aligned));
         }
     }
@@ -227,30 +207,55 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
         if a == usize::from(c.action) || penalty_of(lib, a, &observed) != Some(0) {
             continue;
         }
-        let Some(p) = lib.pattern(a) else { continue };
-        let aligned = n.max(p.min_len());
-        let (e, t) = LOOSE_SHARE;
-        let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
-        let Some(cost) = weighted_cost(&p, tokens, bound) else {
+        let Some((alt, aligned)) = loose_reading(lib, a, tokens, c.start, c.end) else {
             continue;
         };
-        let nearer = best.is_none_or(|(b, b_aligned)| {
-            usize::from(cost) * b_aligned < usize::from(b.cost) * aligned
-        });
-        if nearer {
-            let alt = Candidate {
-                action: a as u8,
-                cost,
-                min_len: p.min_len().min(255) as u8,
-                positions: p.positions().min(255) as u8,
-                cyclic: p.cyclic(),
-                shape: 0,
-                ..*c
-            };
+        if nearer(&alt, aligned, best) {
             best = Some((alt, aligned));
         }
     }
     best.map(|(b, _)| b)
+}
+
+/// Action `a`'s reading of `tokens` (the moving tokens of runs `start..=end`) when within
+/// [`LOOSE_SHARE`] of its aligned length (the tokens', or the pattern's shortest match if
+/// longer): the candidate, without a shape cost, and that aligned length.
+// Inlined into both callers, as the loops were (flash: a shared out-of-line loop was larger).
+#[inline(always)]
+fn loose_reading(
+    lib: &Library<'_>,
+    a: usize,
+    tokens: &[Token],
+    start: u32,
+    end: u32,
+) -> Option<(Candidate, usize)> {
+    let p = lib.pattern(a)?;
+    let aligned = tokens.len().max(p.min_len());
+    // Within the loose share: cost ≤ FULL · aligned · e / t half-edits.
+    let (e, t) = LOOSE_SHARE;
+    let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
+    let cost = weighted_cost(&p, tokens, bound)?;
+    let c = Candidate {
+        action: a as u8,
+        start,
+        end,
+        cost,
+        len: tokens.len().min(usize::from(u16::MAX)) as u16,
+        min_len: p.min_len().min(255) as u8,
+        positions: p.positions().min(255) as u8,
+        cyclic: p.cyclic(),
+        shape: 0,
+    };
+    Some((c, aligned))
+}
+
+/// Whether `c` over `aligned` tokens is nearer than `best`: lower cost per aligned token
+/// (`c.cost / aligned < b.cost / b_aligned`, cross-multiplied).
+#[inline(always)]
+fn nearer(c: &Candidate, aligned: usize, best: Option<(Candidate, usize)>) -> bool {
+    best.is_none_or(|(b, b_aligned)| {
+        usize::from(c.cost) * b_aligned < usize::from(b.cost) * aligned
+    })
 }
 
 /// Stillness after which a phrase that some action's pattern could still go on from stands
