@@ -134,8 +134,7 @@ impl Accum {
     // copy costs flash.
     #[inline(never)]
     pub fn merge(&mut self, o: &Accum) {
-        self.lift += o.lift + self.rise * o.n as f32;
-        self.rise += o.rise;
+        append_height(&mut self.rise, &mut self.lift, o);
         self.n = self.n.saturating_add(o.n);
         for i in 0..QUANTITIES {
             if let (Some(s), Some(s2), Some(x), Some(x2)) = (
@@ -149,6 +148,14 @@ impl Accum {
             }
         }
     }
+}
+
+/// Appends the ticks of `o` to a rise (m) and lift (m·ticks) summed over earlier ticks: every
+/// height `o` measured from its own start lies `rise` higher for the whole.
+#[inline(always)]
+fn append_height(rise: &mut f32, lift: &mut f32, o: &Accum) {
+    *lift += o.lift + *rise * o.n as f32;
+    *rise += o.rise;
 }
 
 /// Scale exponent of each quantity: its value is divided by `mean speed` (linear rates) or
@@ -237,8 +244,7 @@ impl ShapeSums {
 
     /// Adds a run's sums (the run after those added); `still`: the run is STILL.
     pub fn add(&mut self, acc: &Accum, still: bool) {
-        self.lift += acc.lift + self.height * acc.n as f32;
-        self.height += acc.rise;
+        append_height(&mut self.height, &mut self.lift, acc);
         for k in 0..3 {
             self.lin[k] += acc.sum[k];
             self.turn[k] += acc.sum[ANGVEL + k];
