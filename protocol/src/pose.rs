@@ -146,14 +146,15 @@ impl Pose {
         // the host's.
         let big = figurine_fpu::sqrt((1.0 - sum).max(0.0));
         let mut q = [0f32; 4];
-        let mut slot = 0;
+        // The three small components fill the other slots in order (an iterator, not an
+        // index: nothing on this decoding path can panic).
+        let mut rest = small.iter();
         for (i, c) in q.iter_mut().enumerate() {
-            if i == largest {
-                *c = big;
+            *c = if i == largest {
+                big
             } else {
-                *c = small[slot];
-                slot += 1;
-            }
+                rest.next().copied().unwrap_or(0.0)
+            };
         }
         q
     }

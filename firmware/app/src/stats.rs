@@ -1,12 +1,12 @@
 //! The device's counters, shared by the tasks (reported by `GetStats`, cleared by `Reset`).
 
-use core::cell::RefCell;
+use core::cell::Cell;
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex;
 use figurine_protocol::Stats;
 
-static STATS: Mutex<CriticalSectionRawMutex, RefCell<Stats>> = Mutex::new(RefCell::new(Stats {
+static STATS: Mutex<CriticalSectionRawMutex, Cell<Stats>> = Mutex::new(Cell::new(Stats {
     samples: 0,
     invalid_samples: 0,
     samples_dropped: 0,
@@ -24,15 +24,19 @@ static STATS: Mutex<CriticalSectionRawMutex, RefCell<Stats>> = Mutex::new(RefCel
 
 /// Changes the counters in one critical section.
 pub fn update(f: impl FnOnce(&mut Stats)) {
-    STATS.lock(|s| f(&mut s.borrow_mut()));
+    STATS.lock(|s| {
+        let mut v = s.get();
+        f(&mut v);
+        s.set(v);
+    });
 }
 
 /// A copy of the counters.
 pub fn snapshot() -> Stats {
-    STATS.lock(|s| *s.borrow())
+    STATS.lock(Cell::get)
 }
 
 /// Zeroes every counter.
 pub fn clear() {
-    STATS.lock(|s| *s.borrow_mut() = Stats::default());
+    STATS.lock(|s| s.set(Stats::default()));
 }

@@ -10,9 +10,10 @@
 //! every example rose, a punch thrown without its wind-up. A child expects the toy to answer
 //! it. Such a phrase is compared whole with every action ([`weighted_cost`]) and reported as
 //! the nearest one when it is within the share of edits every match is held to
-//! ([`EDIT_SHARE`]), without the action's own bound — or within the looser [`LOOSE_SHARE`]
-//! when no other action is that near and the phrase moved as the action's examples did (its
-//! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example);
+//! ([`EDIT_SHARE`]), without the action's own bound — or as the nearest action within the
+//! looser [`PHRASE_SHARE`] whose examples moved as the phrase did (its
+//! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example; a small
+//! kick whose translation fell under the lever-arm threshold, read as its pitching alone);
 //! otherwise nothing is reported.
 //!
 //! A phrase that some action's pattern could still go on from is no gesture of its own while
@@ -20,7 +21,7 @@
 //! or the rest outlasts every hold ([`OPEN_PHRASE_US`]): a sudden sidestep whose landings the
 //! smoothing took is still a sidestep.
 //!
-//! The same loose reading settles a match the automata did make but whose motion is plainly
+//! A loose reading also settles a match the automata did make but whose motion is plainly
 //! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
 //! same tokens and its examples moved as the match did, that action it is.
 //!
@@ -34,7 +35,7 @@ use crate::alignment::{weighted_cost, FULL};
 use crate::automaton::prefix_alive;
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
-use crate::recognizer::{observed_shape, penalty_of, shape_of};
+use crate::recognizer::{observed_shape, penalty_of};
 use crate::segment::{Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US, SHAPE_CAP};
 use crate::token::{Token, STILL};
 
@@ -105,7 +106,7 @@ pub struct Nearest {
 }
 
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
-/// phrase, when one is near enough ([`EDIT_SHARE`], or [`LOOSE_SHARE`] as the module docs
+/// phrase, when one is near enough ([`EDIT_SHARE`], or [`PHRASE_SHARE`] as the module docs
 /// say). Ties of cost per aligned token go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
 /// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary (the stream
@@ -135,37 +136,34 @@ pub fn nearest_action(
             open: true,
         });
     }
+    // The nearest action within the share every match is held to; and within the looser
+    // phrase share, the nearest of those whose examples moved as the phrase did (a sudden
+    // sidestep's lone hop; a small kick whose translation fell under the lever-arm
+    // threshold, read as its pitching alone). One alignment per action, bounded by the share
+    // it can use: the shape is checked first, and most actions fail it.
     let mut best: Option<(Candidate, usize)> = None;
-    let mut loose = 0usize;
+    let mut alike: Option<(Candidate, usize)> = None;
+    let observed = observed_shape(hist, first, last);
+    let (e, t) = EDIT_SHARE;
     for a in 0..lib.len() {
-        let Some((c, aligned)) = loose_reading(lib, a, tokens, first, last) else {
+        let moved_alike = penalty_of(lib, a, &observed) == Some(0);
+        let share = if moved_alike { PHRASE_SHARE } else { EDIT_SHARE };
+        let Some((c, aligned)) = loose_reading(lib, a, tokens, first, last, share) else {
             continue;
         };
-        loose += 1;
-        if nearer(&c, aligned, best) {
+        if moved_alike && nearer(&c, aligned, alike) {
+            alike = Some((c, aligned));
+        }
+        let within = usize::from(c.cost) * t <= usize::from(FULL) * aligned * e;
+        if within && nearer(&c, aligned, best) {
             best = Some((c, aligned));
         }
     }
-    // Within the share every match is held to; or within the loose share when no other
-    // action comes that near and the phrase moved as the action's examples did (a sudden
-    // sidestep's lone hop, which only the sidestep is anywhere near).
-    let (e, t) = EDIT_SHARE;
-    let candidate = best
-        .filter(|(c, aligned)| {
-            usize::from(c.cost) * t <= usize::from(FULL) * aligned * e
-                || (loose == 1 && shape_agrees(lib, usize::from(c.action), hist, first, last))
-        })
-        .map(|(c, _)| c);
+    let candidate = best.or(alike).map(|(c, _)| c);
     Some(Nearest {
         candidate,
         open: false,
     })
-}
-
-/// Whether runs `first..=last` moved as action `a`'s examples did: the action has a shape,
-/// and the runs' shape lies within its tolerances ([`shape_of`] charges nothing).
-fn shape_agrees(lib: &Library<'_>, a: usize, hist: &History, first: u32, last: u32) -> bool {
-    shape_of(lib, a, hist, first, last) == Some(0)
 }
 
 /// Another reading of candidate `c` (its runs `c.start..=c.end`, at most
@@ -207,7 +205,8 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
         if a == usize::from(c.action) || penalty_of(lib, a, &observed) != Some(0) {
             continue;
         }
-        let Some((alt, aligned)) = loose_reading(lib, a, tokens, c.start, c.end) else {
+        let Some((alt, aligned)) = loose_reading(lib, a, tokens, c.start, c.end, LOOSE_SHARE)
+        else {
             continue;
         };
         if nearer(&alt, aligned, best) {
@@ -218,7 +217,7 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
 }
 
 /// Action `a`'s reading of `tokens` (the moving tokens of runs `start..=end`) when within
-/// [`LOOSE_SHARE`] of its aligned length (the tokens', or the pattern's shortest match if
+/// `share` (edits, tokens) of its aligned length (the tokens', or the pattern's shortest match if
 /// longer): the candidate, without a shape cost, and that aligned length.
 // Inlined into both callers, as the loops were (flash: a shared out-of-line loop was larger).
 #[inline(always)]
@@ -228,11 +227,12 @@ fn loose_reading(
     tokens: &[Token],
     start: u32,
     end: u32,
+    share: (usize, usize),
 ) -> Option<(Candidate, usize)> {
     let p = lib.pattern(a)?;
     let aligned = tokens.len().max(p.min_len());
-    // Within the loose share: cost ≤ FULL · aligned · e / t half-edits.
-    let (e, t) = LOOSE_SHARE;
+    // Within the share: cost ≤ FULL · aligned · e / t half-edits.
+    let (e, t) = share;
     let bound = (usize::from(FULL) * aligned * e / t).min(usize::from(u8::MAX)) as u8;
     let cost = weighted_cost(&p, tokens, bound)?;
     let c = Candidate {
@@ -264,9 +264,14 @@ fn nearer(c: &Candidate, aligned: usize, best: Option<(Candidate, usize)>) -> bo
 /// read only as rising, whose landing the smoothing took, are a sidestep, not half of one.
 pub const OPEN_PHRASE_US: u64 = GAPPED_HOLD_US;
 
-/// Edits per token a stand-alone phrase may be off its nearest action when no other action
-/// is as near and its shape is the action's ([`nearest_action`]), as (edits, tokens).
+/// Edits per token a match the automata made may be off another action that re-reads it
+/// ([`reread`]), as (edits, tokens).
 pub const LOOSE_SHARE: (usize, usize) = (1, 2);
+
+/// Edits per token a stand-alone phrase may be off an action whose examples moved as it did
+/// ([`nearest_action`]), as (edits, tokens): looser than [`LOOSE_SHARE`], because no match
+/// claims the phrase (a re-read overrides one the automata made).
+pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 
 #[cfg(test)]
 mod tests {
@@ -275,6 +280,7 @@ mod tests {
     use crate::alignment::HALF;
     use crate::features::{Accum, Shape, ShapeSums, QUANTITIES, SPEED};
     use crate::pattern::tests::seq_library;
+    use crate::recognizer::shape_of;
     use crate::segment::shape_cost;
     use crate::token::parse_token;
 
@@ -339,8 +345,8 @@ mod tests {
             None
         );
         // … unless the kick's examples left a shape the phrase moves like (these runs carry
-        // no motion sums: no evidence against it) and no other action is within the loose
-        // share: then it is the kick.
+        // no motion sums: no evidence against it): then it is the kick, within the phrase
+        // share.
         let shaped = crate::pattern::tests::with_shapes(&blob, &[Some([0, 0, 255, 0, 0, 128]); 3]);
         let with_shapes = Library::from_bytes(&shaped).unwrap();
         let c = nearest_action(&with_shapes, &h, 0, false, 2, false)
@@ -351,31 +357,61 @@ mod tests {
     }
 
     #[test]
-    fn the_loose_share_needs_one_action_alone_near_and_its_shape() {
-        // A lone `u`: the end of a crouch `d+ u+`, one whole edit in two aligned tokens.
-        let h = history(&[("_", 800), ("u", 200), ("_", 150)]);
-        let shape = Some([0, 255, 0, 0, 0, 128]);
+    fn the_phrase_share_goes_to_the_nearest_action_the_phrase_moved_like() {
+        // A lone `u` that rose: the end of a crouch `d+ u+`, one whole edit in two aligned
+        // tokens.
+        let (h, rose) = moved(&[("u", 20, [0.0, 0.9, 0.0], 0.01)]);
+        let up = Some(shape_bytes(rose));
+        let mut sideways = rose;
+        (sideways[0], sideways[1]) = (rose[1], rose[0]);
+        let left = Some(shape_bytes(sideways));
         let blob = lib_blob();
-        let shaped = crate::pattern::tests::with_shapes(&blob, &[shape; 3]);
-        let lib = Library::from_bytes(&shaped).unwrap();
-        let found = |lib: &Library<'_>| {
-            nearest_action(lib, &h, 0, false, 1, false)
-                .unwrap()
-                .candidate
+        let found = |blob: &[u8], shapes: &[Option<[u8; 6]>]| {
+            let shaped = crate::pattern::tests::with_shapes(blob, shapes);
+            nearest_action(
+                &Library::from_bytes(&shaped).unwrap(),
+                &h,
+                0,
+                false,
+                1,
+                false,
+            )
+            .unwrap()
+            .candidate
+            .map(|c| c.action)
         };
-        assert_eq!(found(&lib).map(|c| c.action), Some(1));
-        // Without a shape learnt for it: nothing.
-        let unshaped = crate::pattern::tests::with_shapes(&blob, &[shape, None, shape]);
-        assert_eq!(found(&Library::from_bytes(&unshaped).unwrap()), None);
-        // With a second action as near (`l+ u+`): nothing either.
+        assert_eq!(found(&blob, &[up; 3]), Some(1));
+        // Without a shape learnt for it, or with examples that moved otherwise: nothing.
+        assert_eq!(found(&blob, &[up, None, up]), None);
+        assert_eq!(found(&blob, &[up, left, up]), None);
+        // A second action as near (`l+ u+`): the one whose examples moved as the phrase did;
+        // when both did, the nearer, and on a tie the lower index.
         let two = seq_library(&[
             (&["b", "f", "b"], 2),
             (&["d", "u"], 1),
             (&["uf.Xn", "b.Xp", "db"], 0),
             (&["l", "u"], 1),
         ]);
-        let shaped = crate::pattern::tests::with_shapes(&two, &[shape; 4]);
-        assert_eq!(found(&Library::from_bytes(&shaped).unwrap()), None);
+        assert_eq!(found(&two, &[up, up, up, left]), Some(1));
+        assert_eq!(found(&two, &[up, left, up, up]), Some(3));
+        assert_eq!(found(&two, &[up; 4]), Some(1));
+        // A phrase further than the phrase share from every action is nothing, whatever its
+        // shape: `l r l`, three edits from the crouch.
+        let far = history(&[("_", 800), ("l", 200), ("r", 200), ("l", 200), ("_", 150)]);
+        let shaped = crate::pattern::tests::with_shapes(&two, &[left; 4]);
+        assert_eq!(
+            nearest_action(
+                &Library::from_bytes(&shaped).unwrap(),
+                &far,
+                0,
+                false,
+                3,
+                false
+            )
+            .unwrap()
+            .candidate,
+            None
+        );
     }
 
     #[test]

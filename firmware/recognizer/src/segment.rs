@@ -178,19 +178,31 @@ impl Candidate {
         (top.max(0) / 3).min(255) as u8
     }
 
-    /// True when `self` should replace `other`: higher merit; at equal merit the more
+    /// True when `self` should replace `other`: higher merit (without the shape costs when
+    /// both are readings of one action from the same run); at equal merit the more
     /// specific pattern (longer shortest match, then fewer positions: a pattern that accepts
     /// fewer strings explains the match better than one that merely allows it), then fewer
     /// edits, then the lower index.
     pub fn beats(&self, other: &Candidate) -> bool {
+        // Two readings of one action from the same run are one performance read to two
+        // ends: their shapes differ only by what the longer one read on through, so the
+        // tokens decide (a jump read on through its landing, not cut into a jump and a crouch).
+        let same = self.action == other.action && self.start == other.start;
+        let merit = |c: &Candidate| {
+            if same {
+                Self::merit_of(usize::from(c.len), c.cost)
+            } else {
+                c.merit()
+            }
+        };
         (
-            self.merit(),
+            merit(self),
             self.min_len,
             other.positions,
             other.cost,
             other.action,
         ) > (
-            other.merit(),
+            merit(other),
             other.min_len,
             self.positions,
             self.cost,
@@ -408,6 +420,25 @@ mod tests {
         // A longer shortest match still comes first: it is the more specific gesture.
         let jump = Candidate { min_len: 3, ..jump };
         assert!(jump.beats(&crouch));
+    }
+
+    #[test]
+    fn two_readings_of_one_action_from_one_run_are_weighed_without_shapes() {
+        // A jump read to its take-off (4 tokens, shape as its examples) and read on through
+        // its landing (6 tokens, whose dip the examples lacked: 2 quarter tokens per 2 tokens).
+        let short = c(2, 1, 4, 0);
+        let long = Candidate {
+            shape: shape_cost(SHAPE_CAP, 6),
+            ..c(2, 1, 6, 0)
+        };
+        assert!(long.merit() < short.merit());
+        // Of one action from the same run, the tokens decide: the whole jump.
+        assert!(long.beats(&short) && !short.beats(&long));
+        // Another action, or the same action from another run, is weighed with its shape.
+        let crouch = Candidate { action: 8, ..short };
+        assert!(crouch.beats(&long) && !long.beats(&crouch));
+        let later = Candidate { start: 2, ..short };
+        assert!(later.beats(&long));
     }
 
     #[test]
