@@ -12,14 +12,20 @@
 //! the nearest one when it is within the share of edits every match is held to
 //! ([`EDIT_SHARE`]), without the action's own bound — or as the nearest action within the
 //! looser [`PHRASE_SHARE`] whose examples moved as the phrase did (its
-//! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example; a small
-//! kick whose translation fell under the lever-arm threshold, read as its pitching alone);
+//! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example);
 //! otherwise nothing is reported.
 //!
 //! A phrase that some action's pattern could still go on from is no gesture of its own while
 //! the figurine rests (it may be holding inside that action), but it is once the stream ends
 //! or the rest outlasts every hold ([`OPEN_PHRASE_US`]): a sudden sidestep whose landings the
 //! smoothing took is still a sidestep.
+//!
+//! Such a closed phrase — a gesture of two strokes or more, made and then rested after for
+//! longer than any hold — was plainly meant as an action even when no action is that near: it
+//! is read as the action with the highest merit per aligned token, its shape cost included,
+//! among those within [`CLOSED_SHARE`] whose examples it moved not too unlike
+//! ([`CLOSED_SHAPE_MAX`]): a small kick whose swing fell under the lever-arm threshold, read
+//! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
 //!
 //! A loose reading also settles a match the automata did make but whose motion is plainly
 //! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
@@ -33,10 +39,11 @@
 
 use crate::alignment::{weighted_cost, FULL};
 use crate::automaton::prefix_alive;
+use crate::features::Shape;
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
 use crate::recognizer::{observed_shape, penalty_of};
-use crate::segment::{Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US, SHAPE_CAP};
+use crate::segment::{shape_cost, Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US, SHAPE_CAP};
 use crate::token::{Token, STILL};
 
 /// Longest phrase that is compared with the actions, moving tokens; a longer one is no single
@@ -107,7 +114,7 @@ pub struct Nearest {
 
 /// The action nearest the stand-alone phrase ending at run `last`, as a candidate over the
 /// phrase, when one is near enough ([`EDIT_SHARE`], or [`PHRASE_SHARE`] as the module docs
-/// say). Ties of cost per aligned token go to the lower action index.
+/// say; [`CLOSED_SHARE`] for a `closed` phrase). Ties go to the lower action index.
 /// None when there is no whole phrase: it reaches back to `floor` or past the history, or is
 /// longer than [`NEAREST_MAX_TOKENS`]. `bounds`: `floor` is a phrase boundary (the stream
 /// began there), not the end of an event.
@@ -138,16 +145,19 @@ pub fn nearest_action(
     }
     // The nearest action within the share every match is held to; and within the looser
     // phrase share, the nearest of those whose examples moved as the phrase did (a sudden
-    // sidestep's lone hop; a small kick whose translation fell under the lever-arm
-    // threshold, read as its pitching alone). One alignment per action, bounded by the share
-    // it can use: the shape is checked first, and most actions fail it.
+    // sidestep's lone hop). One alignment per action, bounded by the share it can use: the
+    // shape is checked first, and most actions fail it.
     let mut best: Option<(Candidate, usize)> = None;
     let mut alike: Option<(Candidate, usize)> = None;
     let observed = observed_shape(hist, first, last);
     let (e, t) = EDIT_SHARE;
     for a in 0..lib.len() {
         let moved_alike = penalty_of(lib, a, &observed) == Some(0);
-        let share = if moved_alike { PHRASE_SHARE } else { EDIT_SHARE };
+        let share = if moved_alike {
+            PHRASE_SHARE
+        } else {
+            EDIT_SHARE
+        };
         let Some((c, aligned)) = loose_reading(lib, a, tokens, first, last, share) else {
             continue;
         };
@@ -159,11 +169,45 @@ pub fn nearest_action(
             best = Some((c, aligned));
         }
     }
-    let candidate = best.or(alike).map(|(c, _)| c);
+    let mut candidate = best.or(alike).map(|(c, _)| c);
+    if candidate.is_none() && closed && tokens.len() >= 2 {
+        candidate = closed_reading(lib, tokens, first, last, &observed);
+    }
     Some(Nearest {
         candidate,
         open: false,
     })
+}
+
+/// The reading of a closed phrase ([`nearest_action`]) with the highest merit per aligned
+/// token, shape cost included ([`Candidate::merit`]), among the actions that read it within
+/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike.
+fn closed_reading(
+    lib: &Library<'_>,
+    tokens: &[Token],
+    first: u32,
+    last: u32,
+    observed: &Shape,
+) -> Option<Candidate> {
+    let mut top: Option<(Candidate, usize)> = None;
+    for a in 0..lib.len() {
+        // An action without a learnt shape gives no evidence the phrase moved like it.
+        let Some(penalty) = penalty_of(lib, a, observed).filter(|&p| p <= CLOSED_SHAPE_MAX) else {
+            continue;
+        };
+        let Some((mut c, aligned)) = loose_reading(lib, a, tokens, first, last, CLOSED_SHARE)
+        else {
+            continue;
+        };
+        c.shape = shape_cost(penalty, aligned);
+        // c.merit / aligned > t.merit / t_aligned, cross-multiplied (|merit| ≤ 4 · 255 · 4).
+        if top.is_none_or(|(t, t_aligned)| {
+            i64::from(c.merit()) * t_aligned as i64 > i64::from(t.merit()) * aligned as i64
+        }) {
+            top = Some((c, aligned));
+        }
+    }
+    top.map(|(c, _)| c)
 }
 
 /// Another reading of candidate `c` (its runs `c.start..=c.end`, at most
@@ -219,7 +263,7 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
 /// Action `a`'s reading of `tokens` (the moving tokens of runs `start..=end`) when within
 /// `share` (edits, tokens) of its aligned length (the tokens', or the pattern's shortest match if
 /// longer): the candidate, without a shape cost, and that aligned length.
-// Inlined into both callers, as the loops were (flash: a shared out-of-line loop was larger).
+// Inlined into its three callers, as the loops were (flash: out of line it is 212 B larger).
 #[inline(always)]
 fn loose_reading(
     lib: &Library<'_>,
@@ -272,6 +316,16 @@ pub const LOOSE_SHARE: (usize, usize) = (1, 2);
 /// ([`nearest_action`]), as (edits, tokens): looser than [`LOOSE_SHARE`], because no match
 /// claims the phrase (a re-read overrides one the automata made).
 pub const PHRASE_SHARE: (usize, usize) = (2, 3);
+
+/// Edits per token a closed phrase (the stream ended, or the figurine rested
+/// [`OPEN_PHRASE_US`] after it) may be off the action it is read as when nothing nearer
+/// claims it ([`nearest_action`]), as (edits, tokens): any reading that is not mostly edits.
+pub const CLOSED_SHARE: (usize, usize) = (1, 1);
+
+/// Most shape penalty ([`crate::segment::shape_penalty`], quarter tokens) an action may have
+/// for a closed phrase to be read as it: half the cap, so a phrase is never read as an action
+/// whose examples moved altogether otherwise.
+pub const CLOSED_SHAPE_MAX: i16 = SHAPE_CAP / 2;
 
 #[cfg(test)]
 mod tests {
@@ -489,6 +543,72 @@ mod tests {
             h.newest_mut().unwrap().end = (i as u32 + 1, t);
         }
         (h, sums.shape())
+    }
+
+    #[test]
+    fn a_closed_phrase_is_read_as_the_action_of_highest_merit_it_moved_not_unlike() {
+        // A small kick read as its pitch alone (`.Xn .Xp`): its little swing forward and back.
+        let (h, swung) = moved(&[
+            (".Xn", 20, [0.0, 0.05, 0.1], 0.0),
+            (".Xp", 20, [0.0, 0.05, 0.1], 0.0),
+        ]);
+        let kick = Some(shape_bytes(swung));
+        let mut up = swung;
+        (up[1], up[2]) = (swung[2], swung[1]);
+        let (blob, tokens) = (
+            lib_blob(),
+            [parse_token(".Xn").unwrap(), parse_token(".Xp").unwrap()],
+        );
+        // Further from the kick than the phrase share: three edits in three aligned tokens.
+        let lib = Library::from_bytes(&blob).unwrap();
+        assert_eq!(
+            weighted_cost(&lib.pattern(2).unwrap(), &tokens, 255),
+            Some(3 * FULL)
+        );
+        let read = |shapes: &[Option<[u8; 6]>], closed: bool| {
+            let shaped = crate::pattern::tests::with_shapes(&blob, shapes);
+            nearest_action(
+                &Library::from_bytes(&shaped).unwrap(),
+                &h,
+                0,
+                false,
+                2,
+                closed,
+            )
+            .unwrap()
+            .candidate
+            .map(|c| (c.action, c.start, c.end, c.cost))
+        };
+        let shapes = [Some(shape_bytes(up)), Some(shape_bytes(up)), kick];
+        // Not while the figurine only paused; once the phrase is closed, the kick.
+        assert_eq!(read(&shapes, false), None);
+        assert_eq!(read(&shapes, true), Some((2, 1, 2, 3 * FULL)));
+        // Not an action whose examples moved otherwise, nor one without a learnt shape.
+        assert_eq!(
+            read(&[shapes[0], shapes[1], Some(shape_bytes(up))], true),
+            None
+        );
+        assert_eq!(read(&[shapes[0], shapes[1], None], true), None);
+        // Among those it moved like, the highest merit per aligned token: the crouch `d u`
+        // (two edits in two tokens) over the kick and the punch (three edits in three).
+        let all = [kick; 3];
+        assert_eq!(read(&all, true).map(|c| c.0), Some(1));
+        // A lone stroke is no gesture, closed or not.
+        let (lone, _) = moved(&[(".Xn", 20, [0.0, 0.05, 0.1], 0.0)]);
+        let shaped = crate::pattern::tests::with_shapes(&blob, &all);
+        assert_eq!(
+            nearest_action(
+                &Library::from_bytes(&shaped).unwrap(),
+                &lone,
+                0,
+                false,
+                1,
+                true
+            )
+            .unwrap()
+            .candidate,
+            None
+        );
     }
 
     /// A shape as the shape table holds it ([`crate::pattern::tests::with_shapes`]).
