@@ -1,7 +1,9 @@
 //! The `figurine` command-line tool: a thin dispatcher; each subcommand lives in its module.
 
 use clap::{Parser, Subcommand};
-use figurine_host::{anim, graph, link, recognize, render, synth};
+#[cfg(feature = "render")]
+use figurine_host::render;
+use figurine_host::{anim, graph, link, recognize, synth};
 
 /// figurine: play with a toy, get a character animation.
 #[derive(Parser, Debug)]
@@ -41,8 +43,10 @@ enum Command {
     /// Style-coherent motion graphs: build, synth, eval (seed 003).
     Graph(graph::cli::GraphArgs),
     /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
+    #[cfg(feature = "render")]
     Render(render::cli::RenderArgs),
     /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
+    #[cfg(feature = "render")]
     View(render::cli::ViewArgs),
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
@@ -50,7 +54,8 @@ enum Command {
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    figurine_host::render::gpu::ensure_runtime_dir();
+    #[cfg(feature = "render")]
+    render::gpu::ensure_runtime_dir();
     match cli.command {
         Command::Synth(a) => synth::cli::run(a)?,
         Command::Tokens(a) => recognize::tokens::run(&a)?,
@@ -65,7 +70,9 @@ fn main() -> anyhow::Result<()> {
         Command::Animate(a) => anim::cli::run_animate(&a)?,
         Command::Clip(a) => anim::cli::run_clip(&a)?,
         Command::Graph(a) => graph::cli::run(a)?,
+        #[cfg(feature = "render")]
         Command::Render(a) => render::cli::run_render(&a)?,
+        #[cfg(feature = "render")]
         Command::View(a) => render::cli::run_view(&a)?,
         Command::ProtocolVersion => {
             println!(

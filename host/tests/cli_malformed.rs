@@ -74,6 +74,7 @@ fn learn_refuses_malformed_examples() {
 }
 
 #[test]
+#[cfg(feature = "render")]
 fn render_refuses_malformed_bvh() {
     let dir = scratch("render");
     let out = dir.join("out.gif");

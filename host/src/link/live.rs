@@ -325,6 +325,9 @@ pub fn live(args: &LiveArgs) -> Result<()> {
     let print = Mutex::new(std::io::stdout());
     let many = specs.len() > 1;
     let stop = AtomicBool::new(false);
+    if args.view && !cfg!(feature = "render") {
+        bail!("--view needs the window viewer: build figurine with its default `render` feature");
+    }
     let view = if args.view {
         Some(start_view(args, &names, specs.len())?)
     } else {
@@ -346,6 +349,7 @@ pub fn live(args: &LiveArgs) -> Result<()> {
                 scope.spawn(move || run_session(plan, names, print, many, stop))
             })
             .collect();
+        #[cfg(feature = "render")]
         if let Some(v) = &view {
             // The window must live on the main thread; closing it ends the session.
             let opts = crate::render::viewer::ViewerOptions {

@@ -28,18 +28,24 @@
 //! `FIGURINE_BLESS=1 cargo test -p figurine-host --test render_gpu golden` (then look at it).
 
 pub mod camera;
+#[cfg(feature = "render")]
 pub mod cli;
 pub mod compose;
 pub mod from_clip;
+#[cfg(feature = "render")]
 pub mod gpu;
 pub mod live;
+#[cfg(feature = "render")]
 pub mod offscreen;
 pub mod overlay;
+#[cfg(feature = "render")]
 pub mod playback;
 pub mod procedural;
 pub mod puppet;
 pub mod scene;
+#[cfg(feature = "render")]
 pub mod video;
+#[cfg(feature = "render")]
 pub mod viewer;
 
 use std::path::PathBuf;
