@@ -200,7 +200,7 @@ fn closed_reading(
             continue;
         };
         c.shape = shape_cost(penalty, aligned);
-        // c.merit / aligned > t.merit / t_aligned, cross-multiplied (|merit| ≤ 4 · 255 · 4).
+        // c.merit / aligned > t.merit / t_aligned, cross-multiplied.
         if top.is_none_or(|(t, t_aligned)| {
             i64::from(c.merit()) * t_aligned as i64 > i64::from(t.merit()) * aligned as i64
         }) {

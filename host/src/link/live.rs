@@ -310,6 +310,9 @@ fn run_session(
 
 /// `figurine live`.
 pub fn live(args: &LiveArgs) -> Result<()> {
+    if args.view && !cfg!(feature = "render") {
+        bail!("--view needs the window viewer: build figurine with its default `render` feature");
+    }
     let names = blobs::load(args.library.as_deref(), None)?.names;
     let specs = args
         .ports
@@ -325,9 +328,6 @@ pub fn live(args: &LiveArgs) -> Result<()> {
     let print = Mutex::new(std::io::stdout());
     let many = specs.len() > 1;
     let stop = AtomicBool::new(false);
-    if args.view && !cfg!(feature = "render") {
-        bail!("--view needs the window viewer: build figurine with its default `render` feature");
-    }
     let view = if args.view {
         Some(start_view(args, &names, specs.len())?)
     } else {

@@ -16,6 +16,10 @@
 //!   feed for puppetry, and the winit window itself.
 //! - [`procedural`]: a procedural walking stick figure for tests, benchmarks and demos.
 //!
+//! The stages that need the GPU or a window (`gpu`, `offscreen`, `video`, `cli`, `playback`,
+//! `viewer`) are the crate's default `render` feature; the scene, camera, overlay, compose and
+//! puppet stages build without it.
+//!
 //! Usage:
 //! ```text
 //! figurine render ANIM.bvh [--doodle LOG.csv] [--events E.jsonl|LABELS.json] \
