@@ -29,7 +29,10 @@
 //!
 //! A loose reading also settles a match the automata did make but whose motion is plainly
 //! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
-//! same tokens and its examples moved as the match did, that action it is.
+//! same tokens and its examples moved as the match did, that action it is. So does a match
+//! that a pause commits while part of its phrase is left unexplained and its motion is unlike
+//! its action's ([`whole_phrase`]): the whole phrase is read as the action its examples moved
+//! like, when one reads it within the same share.
 //!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
 //! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
@@ -243,14 +246,61 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
         i = i.wrapping_add(1);
     }
     let tokens = tok.get(..n)?;
+    nearest_alike(
+        lib,
+        &observed,
+        tokens,
+        c.start,
+        c.end,
+        usize::from(c.action),
+    )
+}
+
+/// A reading of the whole stand-alone phrase ending at run `last` (bounded as for
+/// [`nearest_action`]) when candidate `c`, which a pause is committing, leaves some of its
+/// moving tokens unexplained and moved unlike its action's examples: the nearest action within
+/// [`LOOSE_SHARE`] whose examples moved as the whole phrase did. A kick without its wind-up,
+/// whose forward swing a run matched (`uf.Xn f.Xn`) while its backswing (`b.Xp`) matched
+/// nothing, is one gesture, and a kick.
+#[cold]
+#[inline(never)]
+pub fn whole_phrase(
+    lib: &Library<'_>,
+    hist: &History,
+    floor: u32,
+    bounds: bool,
+    last: u32,
+    c: &Candidate,
+) -> Option<Candidate> {
+    let mut tok = [STILL; NEAREST_MAX_TOKENS];
+    let (n, first, last) = phrase(hist, floor, bounds, last, &mut tok)?;
+    if usize::from(c.len) >= n || c.shape == 0 {
+        return None;
+    }
+    let tokens = tok.get(..n)?;
+    let observed = observed_shape(hist, first, last);
+    nearest_alike(lib, &observed, tokens, first, last, usize::MAX)
+}
+
+/// The nearest reading (by cost per aligned token, then the lower index) of `tokens` (the
+/// moving tokens of runs `start..=end`) within [`LOOSE_SHARE`], among the actions other than
+/// `skip` whose examples moved as `observed` ([`reread`], [`whole_phrase`]).
+#[inline(never)]
+fn nearest_alike(
+    lib: &Library<'_>,
+    observed: &Shape,
+    tokens: &[Token],
+    start: u32,
+    end: u32,
+    skip: usize,
+) -> Option<Candidate> {
     let mut best: Option<(Candidate, usize)> = None;
     for a in 0..lib.len() {
         // The shape first: it is cheaper than the alignment, and most actions fail it.
-        if a == usize::from(c.action) || penalty_of(lib, a, &observed) != Some(0) {
+        if a == skip || penalty_of(lib, a, observed) != Some(0) {
             continue;
         }
-        let Some((alt, aligned)) = loose_reading(lib, a, tokens, c.start, c.end, LOOSE_SHARE)
-        else {
+        let Some((alt, aligned)) = loose_reading(lib, a, tokens, start, end, LOOSE_SHARE) else {
             continue;
         };
         if nearer(&alt, aligned, best) {
@@ -702,6 +752,62 @@ mod tests {
             ..c
         };
         assert_eq!(reread(&mild, &h, &mild_c), None);
+    }
+
+    #[test]
+    fn a_match_that_leaves_its_phrase_half_read_yields_to_the_whole_phrase() {
+        // A kick without its wind-up: forward swing `uf f`, backswing `b`, its recovery lost.
+        let (h, kicked) = moved(&[
+            ("uf", 10, [0.0, 0.5, 0.8], 0.001),
+            ("f", 10, [0.0, 0.1, 0.9], 0.0),
+            ("b", 10, [0.0, 0.1, 0.9], 0.0),
+        ]);
+        // 0: a run's strides `uf f`, shaped unlike this; 1: the kick `uf f b db`, shaped as it.
+        let blob = seq_library(&[(&["uf", "f"], 1), (&["uf", "f", "b", "db"], 1)]);
+        let mut strides = kicked;
+        strides[5] = -0.3;
+        let lib_of = |shapes: [Shape; 2]| {
+            crate::pattern::tests::with_shapes(
+                &blob,
+                &[Some(shape_bytes(shapes[0])), Some(shape_bytes(shapes[1]))],
+            )
+        };
+        let shaped = lib_of([strides, kicked]);
+        let lib = Library::from_bytes(&shaped).unwrap();
+        let c = Candidate {
+            action: 0,
+            start: 1,
+            end: 2,
+            cost: 0,
+            len: 2,
+            min_len: 2,
+            positions: 2,
+            cyclic: true,
+            shape: shape_of(&lib, 0, &h, 1, 2).map_or(0, |p| shape_cost(p, 2)),
+        };
+        assert!(c.shape > 0);
+        // The kick reads all three within the loose share (its `db` left out).
+        let w = whole_phrase(&lib, &h, 0, false, 3, &c).unwrap();
+        let tokens = ["uf", "f", "b"].map(|n| parse_token(n).unwrap());
+        assert_eq!((w.action, w.start, w.end, w.len), (1, 1, 3, 3));
+        assert_eq!(
+            Some(w.cost),
+            weighted_cost(&lib.pattern(1).unwrap(), &tokens, 255)
+        );
+        // Not when the match moved like its action, or explains the whole phrase.
+        assert_eq!(
+            whole_phrase(&lib, &h, 0, false, 3, &Candidate { shape: 0, ..c }),
+            None
+        );
+        assert_eq!(whole_phrase(&lib, &h, 0, false, 2, &c), None);
+        // Nor when the phrase reaches below the floor (part of it was emitted), nor when no
+        // action's examples moved like the phrase.
+        assert_eq!(whole_phrase(&lib, &h, 2, false, 3, &c), None);
+        let unlike = lib_of([strides, strides]);
+        assert_eq!(
+            whole_phrase(&Library::from_bytes(&unlike).unwrap(), &h, 0, false, 3, &c),
+            None
+        );
     }
 
     #[test]

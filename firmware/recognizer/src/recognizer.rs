@@ -5,7 +5,7 @@
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
 //! effort model 0.6 KiB, the last event (open to continuation, [`crate::follow`]), the state
 //! before a provisional report and the last stand-alone phrase's nearest action 0.6 KiB —
-//! 14.8 KiB in all (15,168 B by `size_of`, measured by a test) with 32 actions loaded.
+//! 15.2 KiB in all (15,528 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
@@ -15,7 +15,7 @@ use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample};
-use crate::nearest::{nearest_action, reread, Nearest, OPEN_PHRASE_US};
+use crate::nearest::{nearest_action, reread, whole_phrase, Nearest, OPEN_PHRASE_US};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, CONTINUE_US,
@@ -87,6 +87,9 @@ pub struct Recognizer<'lib> {
     /// last event emitted (a match too brief to emit leaves it), and whether it is a phrase
     /// boundary of its own — where the stream began, a gap cut it, or a long pause passed.
     phrase_floor: (u32, bool),
+    /// [`Self::phrase_floor`] as it was before the provisional report, if one is out: the
+    /// reported candidate's phrase begins after it.
+    report_floor: (u32, bool),
     tokens: u32,
     events: u32,
     now_us: u64,
@@ -113,6 +116,7 @@ impl<'lib> Recognizer<'lib> {
             decider: Decider::new(),
             floor: 0,
             phrase_floor: (0, true),
+            report_floor: (0, true),
             tokens: 0,
             events: 0,
             now_us: 0,
@@ -210,6 +214,23 @@ impl<'lib> Recognizer<'lib> {
                     _ => false,
                 };
                 if let Decision::Commit(c) = self.decider.stillness(still, longer) {
+                    let (floor, bounds) = if self.provisional.is_some() {
+                        self.report_floor
+                    } else {
+                        self.phrase_floor
+                    };
+                    let c = newest
+                        .and_then(|run| {
+                            whole_phrase(
+                                &self.library,
+                                self.front.history(),
+                                floor,
+                                bounds,
+                                run.wrapping_sub(1),
+                                &c,
+                            )
+                        })
+                        .unwrap_or(c);
                     self.commit(c, &mut emit);
                 } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
                     // Held for a longer action that may yet take it over, or for the next
@@ -512,6 +533,7 @@ impl<'lib> Recognizer<'lib> {
         if let Some((ev, continues, held)) = self.outcome(&p, before) {
             self.provisional = Some((p, before, continues));
             self.held = held;
+            self.report_floor = self.phrase_floor;
             self.phrase_floor = (p.end.wrapping_add(1), false);
             self.emit_held(ev, continues, emit);
         }

@@ -178,10 +178,32 @@ pub const INCIDENTAL_ANGLE_RAD: f64 = 0.35;
 /// Share of the gesture's path length below which a run's translation half is incidental.
 pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
 
+/// `s` without its learner-only marks: a rotation wildcard (`f~`) as the written pattern has
+/// it, whatever wobble it was seen with.
+fn bare(s: Symbol) -> Symbol {
+    if s & ANY_ROT != 0 {
+        ((s & 0x3ff) / 27 * 27 + NONE_BIN) | (s & (ANY_ROT | ANY_LIN))
+    } else {
+        s & !WOBBLE_AXES
+    }
+}
+
+/// A wobble symbol without the sign it was seen turning with (both signs about its axis).
+fn unsigned(s: Symbol) -> Symbol {
+    if s & ANY_ROT != 0 && s & WOBBLE_AXES != 0 {
+        ((s & 0x3ff) / 27 * 27 + NONE_BIN) | (s & (ANY_ROT | WOBBLE_AXES))
+    } else {
+        s
+    }
+}
+
 /// Learner-only bits on an incidental-rotation wildcard (`f~`): the axes the wobble was seen
-/// about (bit 10 X, 11 Y, 12 Z). They never reach a library: [`expand_symbol`] writes such a
-/// symbol out as the plain token and its wobbles about that one axis (`f|f.Zp|f.Zn`), so a
-/// punch that rolls a little does not also accept a kick's deliberate pitch.
+/// about (bit 10 X, 11 Y, 12 Z). A wobble the tokenizer saw turning one way also keeps that
+/// token in its low bits (`f.Zp` with [`ANY_ROT`]); a slow one, read without a rotation, keeps
+/// the plain token. They never reach a library: [`expand_symbol`] writes such a symbol out as
+/// the plain token and its wobbles about that one axis (`f|f.Zp`, or `f|f.Zp|f.Zn` when no
+/// sign was seen), so a punch that rolls a little does not also accept a kick's deliberate
+/// pitch.
 pub const WOBBLE_AXES: Symbol = 0b111 << WOBBLE_SHIFT;
 /// Bit of the X axis in [`WOBBLE_AXES`] (Y and Z follow).
 const WOBBLE_SHIFT: u16 = 10;
@@ -219,14 +241,18 @@ fn slow_wobble_axis(acc: &Accum, t: Token) -> Option<u16> {
 }
 
 /// The symbols a learnt symbol stands for in a written pattern: a wildcard with wobble axes
-/// becomes the plain token plus both signs about its one axis (a wobble about two or three
-/// axes stays the full wildcard); every other symbol stands for itself.
+/// becomes the plain token plus the sign it was seen turning with about its one axis, or both
+/// signs when none was seen (a wobble about two or three axes stays the full wildcard); every
+/// other symbol stands for itself.
 pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
     let axes = s & WOBBLE_AXES;
     if axes.count_ones() != 1 || s & ANY_ROT == 0 {
-        return vec![s & !WOBBLE_AXES];
+        return vec![bare(s)];
     }
     let lin = (s & 0x3ff) / 27;
+    if (s & 0x3ff) % 27 != NONE_BIN {
+        return vec![lin * 27 + NONE_BIN, s & 0x3ff];
+    }
     let axis = (axes >> WOBBLE_SHIFT).trailing_zeros() as usize;
     let (l, _) = token_signs(lin * 27 + NONE_BIN);
     let mut out = vec![lin * 27 + NONE_BIN];
@@ -241,7 +267,8 @@ pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
 /// Like [`tokenize_gesture`], but each run is written as the symbol of what it means: a half
 /// that barely moved (a rotation of less than [`INCIDENTAL_ANGLE_RAD`], a translation shorter
 /// than [`INCIDENTAL_PATH_SHARE`] of the path) becomes a wildcard, so `d.Xp` with a 5° tilt is
-/// learnt as `d~`.
+/// learnt as `d~` about X, seen turning `.Xp` ([`WOBBLE_AXES`]). A one-shot action's pattern
+/// then accepts `d` and `d.Xp`; a cyclic one's, which rocks each way in turn, `d.Xn` too.
 pub fn intent_symbols(log: &PoseLog) -> Tokenized {
     intent_of(&log_gesture(log))
 }
@@ -258,7 +285,7 @@ fn intent_of(runs: &[Run]) -> Tokenized {
             let angle = dt * f64::from(r.acc.turn_sum());
             let dist = dt * f64::from(r.acc.sum[SPEED]);
             let sym = if lin != NONE_BIN && ang != NONE_BIN && angle < INCIDENTAL_ANGLE_RAD {
-                (lin * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
+                t | ANY_ROT | wobble_axes(t)
             } else if let Some(axis) = slow_wobble_axis(&r.acc, t) {
                 (lin * 27 + NONE_BIN) | ANY_ROT | (1 << (WOBBLE_SHIFT + axis))
             } else if lin != NONE_BIN && ang != NONE_BIN && dist < INCIDENTAL_PATH_SHARE * path {
@@ -361,6 +388,28 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         .iter()
         .filter(|&&s| s & ANY_ROT != 0 && s & WOBBLE_AXES == 0)
         .map(|&s| (s & 0x3ff) / 27)
+        .collect();
+    // A wobble is no sign where another example turned decisively about the same axis while
+    // making the same stroke: that sign is part of the gesture (a kick leans back as it
+    // strikes, a throw forward), so the wobble stands only for the stroke without a turn.
+    let decisive = |w: Symbol| {
+        let lin = (w & 0x3ff) / 27;
+        set.iter().any(|&t| {
+            t & (ANY_LIN | ANY_ROT) == 0
+                && t / 27 == lin
+                && t % 27 != NONE_BIN
+                && wobble_axes(t) == w & WOBBLE_AXES
+        })
+    };
+    let out: BTreeSet<Symbol> = out
+        .into_iter()
+        .map(|s| {
+            if s & ANY_ROT != 0 && (s & WOBBLE_AXES).count_ones() == 1 && decisive(s) {
+                (s & 0x3ff) / 27 * 27 + NONE_BIN
+            } else {
+                s
+            }
+        })
         .collect();
     let expanded: BTreeSet<Symbol> = out.into_iter().flat_map(expand_symbol).collect();
     // What a full wildcard of the same translation already accepts is not written again.
@@ -504,6 +553,17 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             edit_distance(&m, &twice) < edit_distance(&m, &once)
         })
         || seqs.iter().any(|s| halves(s));
+    // A cyclic action rocks one way and back from cycle to cycle: which way a stroke wobbled
+    // is no part of it. (A one-shot gesture's small turn keeps its sign: a throw's follow-through
+    // dips forward, whatever else varies.)
+    let owned: Vec<Tokenized>;
+    if cyclic {
+        owned = seqs
+            .iter()
+            .map(|s| s.iter().map(|&(t, d)| (unsigned(t), d)).collect())
+            .collect();
+        seqs = owned.iter().collect();
+    }
     seqs.swap(0, best);
     let reference = seqs[0];
     let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
@@ -576,11 +636,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         }
         // Optional groups keep whole wildcards: they tell little apart, and the pattern's
         // positions are better spent on its mandatory columns.
-        let set: BTreeSet<Token> = per_seq
-            .iter()
-            .flatten()
-            .map(|&t| t & !WOBBLE_AXES)
-            .collect();
+        let set: BTreeSet<Token> = per_seq.iter().flatten().map(|&t| bare(t)).collect();
         if set.is_empty() {
             opt.push(None);
             opt_support.push(0);
@@ -1239,11 +1295,72 @@ mod tests {
         assert_eq!(n, ["b", "b.Xp"], "{n:?}");
     }
 
-    /// `name` written as an incidental wobble (what [`intent_symbols`] makes of a run whose
-    /// rotation half barely turned): `f.Zp` → `f~` about Z.
+    /// `name` written as a wobble of either sign about its axes (a slow wobble, or any wobble
+    /// of a cyclic action): `f.Zp` → `f~` about Z.
     fn wobble(name: &str) -> Symbol {
         let t = parse_token(name).unwrap();
         ((t / 27) * 27 + NONE_BIN) | ANY_ROT | wobble_axes(t)
+    }
+
+    /// `name` written as an incidental wobble seen turning its way (what [`intent_symbols`]
+    /// makes of a run whose rotation half barely turned): `f.Zp` → `f~` about Z, seen `.Zp`.
+    fn seen(name: &str) -> Symbol {
+        let t = parse_token(name).unwrap();
+        t | ANY_ROT | wobble_axes(t)
+    }
+
+    #[test]
+    fn a_one_shot_gesture_keeps_the_sign_its_wobbles_were_seen_with() {
+        let names = |v: Vec<Symbol>| -> Vec<String> {
+            let mut n: Vec<String> = v
+                .into_iter()
+                .map(super::super::regex::symbol_name)
+                .collect();
+            n.sort();
+            n
+        };
+        assert_eq!(names(expand_symbol(seen("db.Xn"))), ["db", "db.Xn"]);
+        assert_eq!(
+            names(expand_symbol(unsigned(seen("db.Xn")))),
+            ["db", "db.Xn", "db.Xp"]
+        );
+        assert_eq!(unsigned(seen("db.Xn")), wobble("db.Xn"));
+        assert_eq!(bare(seen("db.Xn")), bare(wobble("db.Xp")));
+        let m = mirror_seq(&vec![(seen("lu.Zp"), 0.1)]);
+        assert_eq!(m[0].0, seen("ru.Zn"));
+        // A wobble beside the same stroke turned decisively about its axis is the plain
+        // stroke: a kick leans back as it strikes, and never forward.
+        let set = BTreeSet::from([wobble("f.Xp"), parse_token("f.Xn").unwrap()]);
+        assert_eq!(names(generalise(&set)), ["f", "f.Xn"]);
+        let set = BTreeSet::from([wobble("f.Xp"), parse_token("f.Zn").unwrap()]);
+        assert_eq!(names(generalise(&set)), ["f", "f.Xn", "f.Xp", "f.Zn"]);
+        let toks = |s: &str| -> Vec<Token> {
+            s.split_whitespace()
+                .map(|w| parse_token(w).unwrap())
+                .collect()
+        };
+        // Throws whose follow-through dipped forward a little each time.
+        let throw = || {
+            vec![
+                (parse_token("ub").unwrap(), 0.2),
+                (parse_token("f.Xp").unwrap(), 0.3),
+                (seen("db.Xn"), 0.2),
+            ]
+        };
+        let re = learn_regex(&[throw(), throw(), throw()]).unwrap();
+        let c = re.compile().unwrap();
+        assert!(c.accepts(&toks("ub f.Xp db.Xn")), "{}", re.to_source());
+        assert!(c.accepts(&toks("ub f.Xp db")), "{}", re.to_source());
+        assert!(!c.accepts(&toks("ub f.Xp db.Xp")), "{}", re.to_source());
+        // A walk rocks one way and back from hop to hop: either sign.
+        let hop = |w: &str| [(parse_token("uf").unwrap(), 0.2), (seen(w), 0.2)];
+        let walk: Tokenized = [hop("df.Zn"), hop("df.Zn")].concat();
+        let re = learn_regex(&[walk.clone(), walk.clone(), walk]).unwrap();
+        assert!(
+            re.compile().unwrap().accepts(&toks("uf df.Zp uf df.Zp")),
+            "{}",
+            re.to_source()
+        );
     }
 
     #[test]
