@@ -178,23 +178,24 @@ pub const INCIDENTAL_ANGLE_RAD: f64 = 0.35;
 /// Share of the gesture's path length below which a run's translation half is incidental.
 pub const INCIDENTAL_PATH_SHARE: f64 = 0.05;
 
-/// `s` without its learner-only marks: a rotation wildcard (`f~`) as the written pattern has
-/// it, whatever wobble it was seen with.
-fn bare(s: Symbol) -> Symbol {
-    if s & ANY_ROT != 0 {
-        ((s & 0x3ff) / 27 * 27 + NONE_BIN) | (s & (ANY_ROT | ANY_LIN))
-    } else {
-        s & !WOBBLE_AXES
-    }
-}
-
 /// A wobble symbol without the sign it was seen turning with (both signs about its axis).
 fn unsigned(s: Symbol) -> Symbol {
     if s & ANY_ROT != 0 && s & WOBBLE_AXES != 0 {
-        ((s & 0x3ff) / 27 * 27 + NONE_BIN) | (s & (ANY_ROT | WOBBLE_AXES))
+        plain(s) | (s & (ANY_ROT | WOBBLE_AXES))
     } else {
         s
     }
+}
+
+/// `s` without its learner-only marks: a rotation wildcard (`f~`) as the written pattern has
+/// it, whatever wobble it was seen with.
+fn bare(s: Symbol) -> Symbol {
+    unsigned(s) & !WOBBLE_AXES
+}
+
+/// The plain stroke of symbol `s`: its translation, no rotation, no marks.
+fn plain(s: Symbol) -> Symbol {
+    (s & 0x3ff) / 27 * 27 + NONE_BIN
 }
 
 /// Learner-only bits on an incidental-rotation wildcard (`f~`): the axes the wobble was seen
@@ -405,7 +406,7 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
         .into_iter()
         .map(|s| {
             if s & ANY_ROT != 0 && (s & WOBBLE_AXES).count_ones() == 1 && decisive(s) {
-                (s & 0x3ff) / 27 * 27 + NONE_BIN
+                plain(s)
             } else {
                 s
             }
