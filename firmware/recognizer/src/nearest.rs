@@ -272,9 +272,13 @@ pub fn whole_phrase(
     last: u32,
     c: &Candidate,
 ) -> Option<Candidate> {
+    // A match that moved like its action stands, whatever follows it: no phrase to gather.
+    if c.shape == 0 {
+        return None;
+    }
     let mut tok = [STILL; NEAREST_MAX_TOKENS];
     let (n, first, last) = phrase(hist, floor, bounds, last, &mut tok)?;
-    if usize::from(c.len) >= n || c.shape == 0 {
+    if usize::from(c.len) >= n {
         return None;
     }
     let tokens = tok.get(..n)?;
@@ -674,6 +678,22 @@ mod tests {
         ]
     }
 
+    /// An exact match of `action` (a two-token pattern) over runs `start..=end`, one token
+    /// each, charged `shape` for its motion.
+    fn exact_match(action: u8, start: u32, end: u32, shape: i16) -> Candidate {
+        Candidate {
+            action,
+            start,
+            end,
+            cost: 0,
+            len: (end - start + 1) as u16,
+            min_len: 2,
+            positions: 2,
+            cyclic: false,
+            shape,
+        }
+    }
+
     #[test]
     fn a_match_unlike_its_action_is_reread_as_the_near_action_it_moved_like() {
         // A jump whose flight the tokens lost (`d u`): it rose well above where it began.
@@ -693,17 +713,7 @@ mod tests {
         let lib = Library::from_bytes(&shaped).unwrap();
         assert_eq!(shape_of(&lib, 0, &h, 1, 2), Some(SHAPE_CAP));
         assert_eq!(shape_of(&lib, 1, &h, 1, 2), Some(0));
-        let c = Candidate {
-            action: 0,
-            start: 1,
-            end: 2,
-            cost: 0,
-            len: 2,
-            min_len: 2,
-            positions: 2,
-            cyclic: false,
-            shape: SHAPE_CAP,
-        };
+        let c = exact_match(0, 1, 2, SHAPE_CAP);
         // The flight's `uf df` left out: within two whole edits in four aligned tokens, the
         // loose share.
         let r = reread(&lib, &h, &c).unwrap();
@@ -774,17 +784,12 @@ mod tests {
         };
         let shaped = lib_of([strides, kicked]);
         let lib = Library::from_bytes(&shaped).unwrap();
-        let c = Candidate {
-            action: 0,
-            start: 1,
-            end: 2,
-            cost: 0,
-            len: 2,
-            min_len: 2,
-            positions: 2,
-            cyclic: true,
-            shape: shape_of(&lib, 0, &h, 1, 2).map_or(0, |p| shape_cost(p, 2)),
-        };
+        let c = exact_match(
+            0,
+            1,
+            2,
+            shape_of(&lib, 0, &h, 1, 2).map_or(0, |p| shape_cost(p, 2)),
+        );
         assert!(c.shape > 0);
         // The kick reads all three within the loose share (its `db` left out).
         let w = whole_phrase(&lib, &h, 0, false, 3, &c).unwrap();

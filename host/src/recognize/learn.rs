@@ -251,8 +251,8 @@ pub fn expand_symbol(s: Symbol) -> Vec<Symbol> {
         return vec![bare(s)];
     }
     let lin = (s & 0x3ff) / 27;
-    if (s & 0x3ff) % 27 != NONE_BIN {
-        return vec![lin * 27 + NONE_BIN, s & 0x3ff];
+    if s & 0x3ff != plain(s) {
+        return vec![plain(s), s & 0x3ff];
     }
     let axis = (axes >> WOBBLE_SHIFT).trailing_zeros() as usize;
     let (l, _) = token_signs(lin * 27 + NONE_BIN);
@@ -394,11 +394,10 @@ pub fn generalise(set: &BTreeSet<Token>) -> Vec<Symbol> {
     // making the same stroke: that sign is part of the gesture (a kick leans back as it
     // strikes, a throw forward), so the wobble stands only for the stroke without a turn.
     let decisive = |w: Symbol| {
-        let lin = (w & 0x3ff) / 27;
         set.iter().any(|&t| {
             t & (ANY_LIN | ANY_ROT) == 0
-                && t / 27 == lin
-                && t % 27 != NONE_BIN
+                && plain(t) == plain(w)
+                && t != plain(t)
                 && wobble_axes(t) == w & WOBBLE_AXES
         })
     };
