@@ -26,13 +26,15 @@
 //! among those within [`CLOSED_SHARE`] whose examples it moved not too unlike
 //! ([`CLOSED_SHAPE_MAX`]): a small kick whose swing fell under the lever-arm threshold, read
 //! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
+//! When it moved plainly unlike every action's examples, the shape tells none from another
+//! and the tokens decide: a kick flicked high (`uf.Xn db.Xp`) where every example swung flat.
 //!
 //! A loose reading also settles a match the automata did make but whose motion is plainly
 //! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
 //! same tokens and its examples moved as the match did, that action it is. So does a match
 //! that a pause commits while part of its phrase is left unexplained and its motion is unlike
-//! its action's ([`whole_phrase`]): the whole phrase is read as the action its examples moved
-//! like, when one reads it within the same share.
+//! its action's ([`whole_phrase`]): the whole phrase is read as the action whose examples it
+//! moved like (or least unlike), when one reads it within the same share.
 //!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
 //! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
@@ -184,7 +186,8 @@ pub fn nearest_action(
 
 /// The reading of a closed phrase ([`nearest_action`]) with the highest merit per aligned
 /// token, shape cost included ([`Candidate::merit`]), among the actions that read it within
-/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike.
+/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike — or no
+/// more unlike than the action it moved least unlike, when that is further.
 fn closed_reading(
     lib: &Library<'_>,
     tokens: &[Token],
@@ -193,9 +196,10 @@ fn closed_reading(
     observed: &Shape,
 ) -> Option<Candidate> {
     let mut top: Option<(Candidate, usize)> = None;
+    let most = least_penalty(lib, observed).max(CLOSED_SHAPE_MAX);
     for a in 0..lib.len() {
         // An action without a learnt shape gives no evidence the phrase moved like it.
-        let Some(penalty) = penalty_of(lib, a, observed).filter(|&p| p <= CLOSED_SHAPE_MAX) else {
+        let Some(penalty) = penalty_of(lib, a, observed).filter(|&p| p <= most) else {
             continue;
         };
         let Some((mut c, aligned)) = loose_reading(lib, a, tokens, first, last, CLOSED_SHARE)
@@ -249,6 +253,7 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
     nearest_alike(
         lib,
         &observed,
+        0,
         tokens,
         c.start,
         c.end,
@@ -259,9 +264,10 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
 /// A reading of the whole stand-alone phrase ending at run `last` (bounded as for
 /// [`nearest_action`]) when candidate `c`, which a pause is committing, leaves some of its
 /// moving tokens unexplained and moved unlike its action's examples: the nearest action within
-/// [`LOOSE_SHARE`] whose examples moved as the whole phrase did. A kick without its wind-up,
-/// whose forward swing a run matched (`uf.Xn f.Xn`) while its backswing (`b.Xp`) matched
-/// nothing, is one gesture, and a kick.
+/// [`LOOSE_SHARE`] among those whose examples the whole phrase moved least unlike (as they
+/// did, when any). A kick without its wind-up, whose forward swing a run matched
+/// (`uf.Xn f.Xn`) while its backswing (`b.Xp`) matched nothing, is one gesture, and a kick —
+/// flicked higher than every example, too.
 #[cold]
 #[inline(never)]
 pub fn whole_phrase(
@@ -283,16 +289,31 @@ pub fn whole_phrase(
     }
     let tokens = tok.get(..n)?;
     let observed = observed_shape(hist, first, last);
-    nearest_alike(lib, &observed, tokens, first, last, usize::MAX)
+    let least = least_penalty(lib, &observed);
+    nearest_alike(lib, &observed, least, tokens, first, last, usize::MAX)
+}
+
+/// The least shape penalty ([`penalty_of`]) any action has for motion of shape `observed`;
+/// 0 when no action has a learnt shape. A phrase that moved unlike every action's examples
+/// moved no less like one than another: the shape then tells apart only the actions it moved
+/// further unlike than that.
+// Two callers, each once per pause at most: one out-of-line copy (flash).
+#[inline(never)]
+fn least_penalty(lib: &Library<'_>, observed: &Shape) -> i16 {
+    (0..lib.len())
+        .filter_map(|a| penalty_of(lib, a, observed))
+        .min()
+        .unwrap_or(0)
 }
 
 /// The nearest reading (by cost per aligned token, then the lower index) of `tokens` (the
 /// moving tokens of runs `start..=end`) within [`LOOSE_SHARE`], among the actions other than
-/// `skip` whose examples moved as `observed` ([`reread`], [`whole_phrase`]).
+/// `skip` whose examples `observed` moved `penalty` unlike ([`reread`], [`whole_phrase`]).
 #[inline(never)]
 fn nearest_alike(
     lib: &Library<'_>,
     observed: &Shape,
+    penalty: i16,
     tokens: &[Token],
     start: u32,
     end: u32,
@@ -301,7 +322,7 @@ fn nearest_alike(
     let mut best: Option<(Candidate, usize)> = None;
     for a in 0..lib.len() {
         // The shape first: it is cheaper than the alignment, and most actions fail it.
-        if a == skip || penalty_of(lib, a, observed) != Some(0) {
+        if a == skip || penalty_of(lib, a, observed) != Some(penalty) {
             continue;
         }
         let Some((alt, aligned)) = loose_reading(lib, a, tokens, start, end, LOOSE_SHARE) else {
@@ -377,8 +398,9 @@ pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 pub const CLOSED_SHARE: (usize, usize) = (1, 1);
 
 /// Most shape penalty ([`crate::segment::shape_penalty`], quarter tokens) an action may have
-/// for a closed phrase to be read as it: half the cap, so a phrase is never read as an action
-/// whose examples moved altogether otherwise.
+/// for a closed phrase to be read as it, unless every action has more ([`nearest_action`]):
+/// half the cap, so a phrase is never read as an action whose examples moved altogether
+/// otherwise while another's moved about as it did.
 pub const CLOSED_SHAPE_MAX: i16 = SHAPE_CAP / 2;
 
 #[cfg(test)]
@@ -637,12 +659,14 @@ mod tests {
         // Not while the figurine only paused; once the phrase is closed, the kick.
         assert_eq!(read(&shapes, false), None);
         assert_eq!(read(&shapes, true), Some((2, 1, 2, 3 * FULL)));
-        // Not an action whose examples moved otherwise, nor one without a learnt shape.
-        assert_eq!(
-            read(&[shapes[0], shapes[1], Some(shape_bytes(up))], true),
-            None
-        );
-        assert_eq!(read(&[shapes[0], shapes[1], None], true), None);
+        // Not an action whose examples moved otherwise while the kick's moved as it did (the
+        // crouch reads it at a higher merit) — but when it moved unlike every action's
+        // examples, the shape tells none from another, and the tokens decide: the crouch `d u`
+        // (two edits in two tokens) over the kick and the punch (three edits in three).
+        let unlike = [shapes[0], shapes[1], Some(shape_bytes(up))];
+        assert_eq!(read(&unlike, true).map(|c| c.0), Some(1));
+        // Nor an action without a learnt shape.
+        assert_eq!(read(&[None; 3], true), None);
         // Among those it moved like, the highest merit per aligned token: the crouch `d u`
         // (two edits in two tokens) over the kick and the punch (three edits in three).
         let all = [kick; 3];
@@ -805,14 +829,28 @@ mod tests {
             None
         );
         assert_eq!(whole_phrase(&lib, &h, 0, false, 2, &c), None);
-        // Nor when the phrase reaches below the floor (part of it was emitted), nor when no
-        // action's examples moved like the phrase.
+        // Nor when the phrase reaches below the floor (part of it was emitted).
         assert_eq!(whole_phrase(&lib, &h, 2, false, 3, &c), None);
-        let unlike = lib_of([strides, strides]);
-        assert_eq!(
-            whole_phrase(&Library::from_bytes(&unlike).unwrap(), &h, 0, false, 3, &c),
-            None
-        );
+        // When no action's examples moved like the phrase, those it moved least unlike: both
+        // alike here, and the kick reads it nearer …
+        let read = |shapes: [Shape; 2]| {
+            let blob = lib_of(shapes);
+            let lib = Library::from_bytes(&blob).unwrap();
+            let pens = [shape_of(&lib, 0, &h, 1, 3), shape_of(&lib, 1, &h, 1, 3)];
+            (
+                pens,
+                whole_phrase(&lib, &h, 0, false, 3, &c).map(|w| w.action),
+            )
+        };
+        let (pens, action) = read([strides, strides]);
+        assert_eq!((pens, action), ([Some(SHAPE_CAP); 2], Some(1)));
+        // … but not an action it moved further unlike than another: the run's examples rose a
+        // little less than the phrase, the kick's far less.
+        let mut lower = kicked;
+        lower[5] -= 0.09;
+        let ([run, kick], action) = read([lower, strides]);
+        assert!(Some(0) < run && run < kick, "{run:?} {kick:?}");
+        assert_eq!(action, Some(0));
     }
 
     #[test]

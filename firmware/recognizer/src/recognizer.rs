@@ -285,7 +285,9 @@ impl<'lib> Recognizer<'lib> {
     /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
     /// under way: then a pause after `p` is a hold inside that longer gesture — a punch held at
     /// full reach after its forward stroke. When `p` needed a whole edit, a match under way
-    /// that is not exact but costs less than `p` ([`prefix_cost`]) counts too.
+    /// that is not exact but costs less than `p` ([`prefix_cost`]) counts too, begun with `p`
+    /// or at its second token: a crouch held low, whose descent a jump explained by taking a
+    /// sideways wobble before it as its lead-in and leaving its hop out.
     // Once per pause at most: kept out of the per-sample path (flash, not speed).
     #[cold]
     #[inline(never)]
@@ -322,22 +324,12 @@ impl<'lib> Recognizer<'lib> {
         let tolerance = if p.cost >= FULL { p.cost - 1 } else { 0 };
         let alive_from = |from: usize, skip_first: bool| {
             let tokens = moving.get(from..).unwrap_or(&[]);
-            (0..self.library.len()).any(|a| {
-                a != usize::from(p.action)
-                    && self.library.pattern(a).is_some_and(|pat| {
-                        // Its match so far covers all of `p` and needs more: a longer one.
-                        prefix_alive(&pat, tokens, skip_first)
-                            || (!skip_first
-                                && tolerance > 0
-                                && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
-                                    .is_some())
-                    })
-            })
+            under_way(&self.library, p.action, tokens, skip_first, tolerance)
         };
         // Begun with the pending candidate, but without its own first part, or exactly a
-        // little earlier; or, tolerantly, with it.
+        // little earlier; or, tolerantly, with it or one token into it.
         alive_from(ps, true)
-            || (tolerance > 0 && alive_from(ps, false))
+            || (tolerance > 0 && (alive_from(ps, false) || alive_from(ps + 1, false)))
             || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
@@ -657,6 +649,31 @@ impl<'lib> Recognizer<'lib> {
             None => self.emit_held(ev, revises, emit),
         }
     }
+}
+
+/// Whether an action other than `skip` has `tokens` as the start of a match that is not over
+/// ([`prefix_alive`]; `skip_first`: its own first part skipped) — or, unless `skip_first`,
+/// one that costs at most `tolerance` half-edits so far ([`prefix_cost`]).
+// Up to five calls per pause: one out-of-line copy (flash).
+#[inline(never)]
+fn under_way(
+    lib: &Library<'_>,
+    skip: u8,
+    tokens: &[Token],
+    skip_first: bool,
+    tolerance: u8,
+) -> bool {
+    (0..lib.len()).any(|a| {
+        a != usize::from(skip)
+            && lib.pattern(a).is_some_and(|pat| {
+                // Its match so far covers all of the tokens and needs more: a longer one.
+                prefix_alive(&pat, tokens, skip_first)
+                    || (!skip_first
+                        && tolerance > 0
+                        && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
+                            .is_some())
+            })
+    })
 }
 
 /// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); None
@@ -1119,6 +1136,33 @@ mod tests {
         let crouch = ev.last().unwrap();
         assert!(
             crouch.start_us < 800_000 && crouch.end_us > 1_900_000,
+            "{ev:?}"
+        );
+    }
+
+    #[test]
+    fn a_match_that_needed_an_edit_waits_for_a_closer_one_begun_inside_it() {
+        // A sideways stroke just before a pitched descent: "jump" explains `r d.Xp d` by
+        // leaving its hop out (a whole edit); "crouch" began at the descent, half an edit off
+        // (the pitch), and is not finished: the hold is part of it, not the end of a jump.
+        let blob = seq_library(&[(&["r", "u", "d.Xp", "d"], 1), (&["d", "u"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
+        let samples: Vec<Sample> = crouch_held_low(0.8)
+            .into_iter()
+            .map(|mut s| {
+                let t = s.t_us as f32 * 1e-6;
+                s.pos[0] -= 0.05 * ramp((t - 0.25) / 0.15);
+                s
+            })
+            .collect();
+        let ev = run(&lib, &samples);
+        // The jump is reported after the usual pause, then revised.
+        let got: Vec<_> = ev.iter().map(|e| (e.action, e.revises)).collect();
+        assert_eq!(got.last(), Some(&(1, true)), "{ev:?}");
+        let crouch = ev.last().unwrap();
+        assert!(
+            crouch.start_us > 600_000 && crouch.end_us > 1_900_000,
             "{ev:?}"
         );
     }
