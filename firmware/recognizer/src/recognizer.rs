@@ -14,12 +14,12 @@ use crate::features::{segment_features, Shape, ShapeSums};
 use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
-use crate::intake::{IntakeCounters, Sample};
+use crate::intake::{IntakeCounters, Sample, TICK_S};
 use crate::nearest::{nearest_action, reread, whole_phrase, Nearest, OPEN_PHRASE_US};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, CONTINUE_US,
-    GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, BRIEF_TURN_RAD,
+    CONTINUE_US, GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::token::{Token, STILL};
 
@@ -559,10 +559,12 @@ impl<'lib> Recognizer<'lib> {
         let hist = self.front.history();
         let start = hist.get(c.start)?.start;
         let end = hist.get(c.end)?.end;
-        if end.1.saturating_sub(start.1) < MIN_ACTION_US {
+        if end.1.saturating_sub(start.1) < MIN_ACTION_US
+            && hist.accum(c.start, c.end).turn_sum() * TICK_S < BRIEF_TURN_RAD
+        {
             // A flicker of a token or two that happens to spell a short pattern: no child's
-            // gesture is this brief. (Checked first: a pending candidate may be asked about
-            // on every sample of a pause.)
+            // gesture is this brief, unless it turned the figurine round. (Checked first: a
+            // pending candidate may be asked about on every sample of a pause.)
             return None;
         }
         // Effort is read over the whole motion phrase around the match — out to the stillness
@@ -1093,6 +1095,38 @@ mod tests {
         assert!(ev[0].start_us < 400_000 && ev[0].end_us > 900_000, "{ev:?}");
         // A stroke alone stays too brief.
         assert_eq!(run(&lib, &quick_strokes(&[left])), [], "one stroke");
+    }
+
+    /// A twist about the vertical axis by `angle` rad in 0.12 s, after 0.6 s of stillness and
+    /// before 0.8 s more, at 200 Hz.
+    fn quick_twist(angle: f32) -> Vec<Sample> {
+        let rate = 200.0f32;
+        let (lead, twist) = (0.6f32, 0.12f32);
+        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
+        (0..((lead + twist + 0.8) * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let half = 0.5 * angle * ramp((t - lead) / twist);
+                Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, 1.0, 0.0],
+                    quat: [libm::cosf(half), 0.0, libm::sinf(half), 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_sudden_turn_briefer_than_any_gesture_is_still_one() {
+        let blob = seq_library(&[(&[".Yp"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // Two thirds of a right angle in 0.12 s: a flicker as far as brevity goes …
+        assert_eq!(run(&lib, &quick_twist(1.0)), []);
+        // … a half turn is a turn.
+        let ev = run(&lib, &quick_twist(core::f32::consts::PI));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert!(ev[0].end_us - ev[0].start_us < MIN_ACTION_US, "{ev:?}");
     }
 
     #[test]
