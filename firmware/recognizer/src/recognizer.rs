@@ -563,8 +563,8 @@ impl<'lib> Recognizer<'lib> {
             && hist.accum(c.start, c.end).turn_sum() * TICK_S < BRIEF_TURN_RAD
         {
             // A flicker of a token or two that happens to spell a short pattern: no child's
-            // gesture is this brief, unless it turned the figurine round. (Checked first: a
-            // pending candidate may be asked about on every sample of a pause.)
+            // gesture is this brief, unless it turned the figurine a quarter turn. (Checked
+            // first: a pending candidate may be asked about on every sample of a pause.)
             return None;
         }
         // Effort is read over the whole motion phrase around the match — out to the stillness
@@ -653,9 +653,9 @@ impl<'lib> Recognizer<'lib> {
     }
 }
 
-/// Whether an action other than `skip` has `tokens` as the start of a match that is not over
-/// ([`prefix_alive`]; `skip_first`: its own first part skipped) — or, unless `skip_first`,
-/// one that costs at most `tolerance` half-edits so far ([`prefix_cost`]).
+/// Whether an action other than `skip` has `tokens` (at least one) as the start of a match
+/// that is not over ([`prefix_alive`]; `skip_first`: its own first part skipped) — or, unless
+/// `skip_first`, one that costs at most `tolerance` half-edits so far ([`prefix_cost`]).
 // Up to five calls per pause: one out-of-line copy (flash).
 #[inline(never)]
 fn under_way(
@@ -665,17 +665,19 @@ fn under_way(
     skip_first: bool,
     tolerance: u8,
 ) -> bool {
-    (0..lib.len()).any(|a| {
-        a != usize::from(skip)
-            && lib.pattern(a).is_some_and(|pat| {
-                // Its match so far covers all of the tokens and needs more: a longer one.
-                prefix_alive(&pat, tokens, skip_first)
-                    || (!skip_first
-                        && tolerance > 0
-                        && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
-                            .is_some())
-            })
-    })
+    // Nothing begun is nothing under way (every pattern's start is "not over").
+    !tokens.is_empty()
+        && (0..lib.len()).any(|a| {
+            a != usize::from(skip)
+                && lib.pattern(a).is_some_and(|pat| {
+                    // Its match so far covers all of the tokens and needs more: a longer one.
+                    prefix_alive(&pat, tokens, skip_first)
+                        || (!skip_first
+                            && tolerance > 0
+                            && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
+                                .is_some())
+                })
+        })
 }
 
 /// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); None
@@ -1199,6 +1201,17 @@ mod tests {
             crouch.start_us > 600_000 && crouch.end_us > 1_900_000,
             "{ev:?}"
         );
+    }
+
+    #[test]
+    fn nothing_begun_is_no_action_under_way() {
+        let blob = seq_library(&[(&["f"], 0), (&["d", "u"], 1)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let d = crate::token::parse_token("d").unwrap();
+        assert!(under_way(&lib, 0, &[d], false, 0));
+        // Not the pending candidate's own action, and not from no tokens at all.
+        assert!(!under_way(&lib, 1, &[d], false, 0));
+        assert!(!under_way(&lib, 0, &[], false, 1));
     }
 
     #[test]
