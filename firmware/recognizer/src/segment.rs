@@ -124,7 +124,7 @@ pub const fn edits_fit(cost: u8, len: usize) -> bool {
 pub const MIN_ACTION_US: u64 = 150_000;
 /// Angle a match briefer than [`MIN_ACTION_US`] must have turned to be emitted all the same,
 /// rad (the turning about the three object axes summed): a quarter turn. A flicker does not
-/// turn the figurine that far; a sudden turn does, in a tenth of a second.
+/// turn the figurine that far; a sudden turn does, in little more than a tenth of a second.
 pub const BRIEF_TURN_RAD: f32 = core::f32::consts::FRAC_PI_2;
 /// Moving runs before a pending candidate where a longer action in progress may have begun.
 pub const HOLD_BACK_TOKENS: usize = 2;
