@@ -564,7 +564,8 @@ impl<'lib> Recognizer<'lib> {
         {
             // A flicker of a token or two that happens to spell a short pattern: no child's
             // gesture is this brief, unless it turned the figurine a quarter turn. (Checked
-            // first: a pending candidate may be asked about on every sample of a pause.)
+            // first, before the phrase around the match is gathered for its effort; once per
+            // report or commit, not per sample.)
             return None;
         }
         // Effort is read over the whole motion phrase around the match — out to the stillness
@@ -1014,11 +1015,15 @@ mod tests {
         assert!(ev[1].start_us > ev[0].end_us);
     }
 
+    /// A smooth step from 0 (x ≤ 0) to 1 (x ≥ 1): how the test strokes move.
+    fn ramp(x: f32) -> f32 {
+        0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0))
+    }
+
     /// A thrust forward (0.4 s), a pause of `hold_s`, the return (0.4 s), at 120 Hz.
     fn thrust_and_return(hold_s: f32) -> Vec<Sample> {
         let rate = 120.0f32;
         let (still, stroke) = (0.6f32, 0.4f32);
-        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
         let total = 2.0 * still + 2.0 * stroke + hold_s + 0.6;
         (0..(total * rate) as u32)
             .map(|i| {
@@ -1040,7 +1045,6 @@ mod tests {
     fn crouch_held_low(hold_s: f32) -> Vec<Sample> {
         let rate = 120.0f32;
         let (still, stroke) = (0.6f32, 0.4f32);
-        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
         let total = 2.0 * still + 2.0 * stroke + hold_s;
         (0..(total * rate) as u32)
             .map(|i| {
@@ -1063,7 +1067,6 @@ mod tests {
     fn quick_strokes(dirs: &[[f32; 3]]) -> Vec<Sample> {
         let rate = 200.0f32;
         let (lead, stroke, gap) = (0.3f32, 0.12f32, 0.15f32);
-        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
         let total = lead + dirs.len() as f32 * (stroke + gap) + 1.0;
         (0..(total * rate) as u32)
             .map(|i| {
@@ -1104,7 +1107,6 @@ mod tests {
     fn quick_twist(angle: f32) -> Vec<Sample> {
         let rate = 200.0f32;
         let (lead, twist) = (0.6f32, 0.12f32);
-        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
         (0..((lead + twist + 0.8) * rate) as u32)
             .map(|i| {
                 let t = i as f32 / rate;
@@ -1183,7 +1185,6 @@ mod tests {
         // (the pitch), and is not finished: the hold is part of it, not the end of a jump.
         let blob = seq_library(&[(&["r", "u", "d.Xp", "d"], 1), (&["d", "u"], 1)]);
         let lib = Library::from_bytes(&blob).unwrap();
-        let ramp = |x: f32| 0.5 - 0.5 * libm::cosf(core::f32::consts::PI * x.clamp(0.0, 1.0));
         let samples: Vec<Sample> = crouch_held_low(0.8)
             .into_iter()
             .map(|mut s| {
