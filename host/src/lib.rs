@@ -3,6 +3,7 @@
 //! Modules are named after their stage in the data flow (see DESIGN.md).
 
 pub mod anim;
+pub mod chart;
 pub mod data;
 pub mod events;
 pub mod graph;

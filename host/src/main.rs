@@ -26,7 +26,8 @@ enum Command {
     TrainEffort(recognize::effort_train::TrainEffortArgs),
     /// Run the recognizer on a pose log and print the recognised actions.
     Simulate(recognize::simulate::SimulateArgs),
-    /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9).
+    /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9);
+    /// `eval rest`: false alarms per hour at rest; `eval sweep`: robustness to noise, rate, scale.
     Eval(recognize::eval::EvalArgs),
     /// List serial ports (and, with --probe, the figurines on them).
     Devices(link::cli::DevicesArgs),

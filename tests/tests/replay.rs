@@ -11,8 +11,9 @@ use figurine_host::link::{replay_log, Device, ReplayOptions};
 use figurine_host::poselog::PoseLog;
 use figurine_host::recognize::eval::learn_synth_library;
 use figurine_host::recognize::simulate::simulate_log;
-use figurine_host::synth::knobs::Knobs;
+use figurine_host::synth::knobs::{Knobs, Range};
 use figurine_host::synth::sequence::sequence;
+use figurine_host::synth::{rest_log, RestKind, RestSpec, TrackerLevel};
 use figurine_recognizer::EffortModel;
 
 /// Samples of each real stream replayed (keeps the test within seconds).
@@ -91,6 +92,38 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
     assert!(
         events > 0,
         "the synthetic sequences produced no events at all"
+    );
+    // A noisy tracker: the learnt noise floor (a 3×3 covariance, its inverse, medians) must
+    // come out bit for bit the same on the device, or the events would differ.
+    let noisy = Knobs {
+        noise: Range::fixed(3.0),
+        ..Knobs::default()
+    };
+    let mut noisy_events = 0;
+    for seed in [4u64, 5] {
+        let doodle = sequence(seed, &noisy, 4, None);
+        noisy_events += check_identical(
+            &mut dev,
+            &blobs,
+            &doodle.log,
+            &format!("noise ×3, seed {seed}"),
+        );
+    }
+    assert!(noisy_events > 0, "the noisy sequences produced no events");
+    let rest = rest_log(
+        6,
+        &RestSpec {
+            seconds: 60.0,
+            kind: Some(RestKind::Hand),
+            tracker: TrackerLevel::by_name("webcam-far"),
+            ..RestSpec::default()
+        },
+    );
+    check_identical(
+        &mut dev,
+        &blobs,
+        &rest.log,
+        "a minute held in a hand, webcam tag",
     );
     // A sequence with revised events (a cyclic action going on after a pause, or an action
     // reported early and then taken over by a longer one): the device's `Revised` messages

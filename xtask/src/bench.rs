@@ -1,8 +1,9 @@
-//! `cargo xtask bench`: every figure the issues ask for, printed (nothing here is a test).
+//! `cargo xtask bench`: every figure the issues ask for, printed (nothing here is a test); the
+//! benchmark plots (false alarms at rest, the robustness sweep) are written to `target/bench/`.
 
 use anyhow::Result;
 
-use crate::util::{cargo, run, step};
+use crate::util::{cargo, root, run, step};
 
 /// Runs one of the host crate's benchmark examples in release mode.
 fn host_example(name: &str) -> Result<()> {
@@ -17,7 +18,24 @@ fn host_example(name: &str) -> Result<()> {
     ]))
 }
 
-/// Runs every benchmark in turn, each printing its own figures with its command.
+/// Runs `figurine ARGS…` built in release mode.
+fn figurine(args: &[&str]) -> Result<()> {
+    run(cargo()
+        .args([
+            "run",
+            "-q",
+            "--release",
+            "-p",
+            "figurine-host",
+            "--bin",
+            "figurine",
+            "--",
+        ])
+        .args(args))
+}
+
+/// Runs every benchmark in turn, each printing its own figures with its command; the plots go
+/// to `target/bench/`.
 pub fn bench() -> Result<()> {
     crate::setup::setup()?;
 
@@ -28,17 +46,22 @@ pub fn bench() -> Result<()> {
     run(cargo().args(["bench", "-p", "figurine-host", "--bench", "recognizer"]))?;
 
     step("recognition accuracy: figurine eval (fresh seed, each action learnt from 3 examples)");
-    run(cargo().args([
-        "run",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--bin",
-        "figurine",
-        "--",
-        "eval",
-    ]))?;
+    figurine(&["eval"])?;
+
+    let plots = root().join("target/bench");
+    let rest_png = plots.join("rest_false_alarms.png");
+    step(&format!(
+        "false alarms per hour at rest: figurine eval rest --plot {}",
+        rest_png.display()
+    ));
+    figurine(&["eval", "rest", "--plot", &rest_png.to_string_lossy()])?;
+
+    let sweep_png = plots.join("robustness_sweep.png");
+    step(&format!(
+        "robustness to tracker noise, rate and doodle scale: figurine eval sweep --plot {}",
+        sweep_png.display()
+    ));
+    figurine(&["eval", "sweep", "--plot", &sweep_png.to_string_lossy()])?;
 
     step("firmware: sizes, instructions per sample, latency, sustained rate");
     if !crate::util::have("defmt-print") {

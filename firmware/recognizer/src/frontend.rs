@@ -154,7 +154,7 @@ impl Frontend {
     fn restart(&mut self) {
         self.filter.reset();
         self.features.reset();
-        self.tokenizer = Tokenizer::new();
+        self.tokenizer.restart();
         self.history.clear();
         self.cand = Accum::new();
     }

@@ -54,6 +54,7 @@ pub mod frontend;
 pub mod history;
 pub mod intake;
 pub mod nearest;
+pub mod noise;
 pub mod pattern;
 pub mod recognizer;
 pub mod segment;

@@ -4,11 +4,11 @@
 //! {−, 0, +}. A component counts only when it carries a real share of its vector's norm
 //! (≥ [`DOM_ON`] to switch on, stays on down to [`DOM_OFF`]: hysteresis against flicker on bin
 //! borders), so direction bins depend on the direction of motion only — not on its size or
-//! speed. A whole vector (translation or rotation) counts only when its norm exceeds both an
-//! absolute noise floor ([`V_FLOOR_M_S`], [`W_FLOOR_RAD_S`]) and [`REL_ACTIVE`] × its own
-//! recent peak (decaying with time constant [`PEAK_TAU_S`]): thresholds are relative to the
-//! motion's own scale, and sensor noise during a pure turn does not become translation (nor
-//! tremor during a slide rotation). Translation smaller than [`ARM_M`] × |ω| is what a figurine
+//! speed. A whole vector (translation or rotation) counts only when it moves against the
+//! sensor's noise as learnt from the stream ([`crate::noise`]) and exceeds [`REL_ACTIVE`] ×
+//! its own recent peak (decaying with time constant [`PEAK_TAU_S`]): thresholds are relative
+//! to the tracker's noise and to the motion's own scale, and sensor noise during a pure turn
+//! does not become translation (nor tremor during a slide rotation). Translation smaller than [`ARM_M`] × |ω| is what a figurine
 //! held off its centre does when turning, and is ignored too. Neither active → STILL.
 //!
 //! A new token must persist [`MIN_TOKEN_US`] before it counts (flicker suppression); a shorter
@@ -25,6 +25,7 @@ use core::fmt;
 use crate::fmath;
 use crate::frame::Kinematics;
 use crate::intake::{TICK_S, TICK_US};
+use crate::noise::NoiseFloor;
 
 /// A token code: `lin × 27 + ang` for motion, [`STILL`] for stillness.
 pub type Token = u16;
@@ -43,10 +44,6 @@ pub const NONE_BIN: u16 = 13;
 pub const DOM_ON: f32 = 0.55;
 /// Component share below which an active sign switches off.
 pub const DOM_OFF: f32 = 0.35;
-/// Translation noise floor, m/s.
-pub const V_FLOOR_M_S: f32 = 0.07;
-/// Rotation noise floor, rad/s (≈ 34 °/s).
-pub const W_FLOOR_RAD_S: f32 = 0.6;
 /// Share of the recent peak below which a vector is inactive.
 pub const REL_ACTIVE: f32 = 0.10;
 /// Time constant of the decaying peak, seconds.
@@ -314,6 +311,7 @@ pub struct Tokenizer {
     /// `swept`; recorded only while the current run is STILL).
     sweep: [Token; SWEEP_TICKS],
     swept: usize,
+    floor: NoiseFloor,
 }
 
 impl Default for Tokenizer {
@@ -355,7 +353,22 @@ impl Tokenizer {
             turned: [0.0; 3],
             sweep: [STILL; SWEEP_TICKS],
             swept: 0,
+            floor: NoiseFloor::new(),
         }
+    }
+
+    /// A fresh tokenizer that keeps the noise floor learnt so far (after a tracker gap the
+    /// tracker is still the same).
+    pub fn restart(&mut self) {
+        *self = Tokenizer {
+            floor: self.floor,
+            ..Tokenizer::new()
+        };
+    }
+
+    /// The learnt noise floor.
+    pub fn noise_floor(&self) -> &NoiseFloor {
+        &self.floor
     }
 
     /// The token seen most often among the swept ticks (the later one on a tie).
@@ -378,8 +391,15 @@ impl Tokenizer {
         let wn = fmath::norm3(k.w);
         self.v_peak = fmath::max(vn, self.v_peak * PEAK_DECAY);
         self.w_peak = fmath::max(wn, self.w_peak * PEAK_DECAY);
-        let v_on = vn >= fmath::max(V_FLOOR_M_S, REL_ACTIVE * self.v_peak) && vn >= ARM_M * wn;
-        let w_on = wn >= fmath::max(W_FLOOR_RAD_S, REL_ACTIVE * self.w_peak);
+        let world_vn = fmath::norm3(k.world_v);
+        self.floor.push(k.world_v, world_vn, k.w, wn);
+        let v_on = self
+            .floor
+            .translating(k.world_v, world_vn, self.lin != [0; 3])
+            && vn >= REL_ACTIVE * self.v_peak
+            && vn >= ARM_M * wn;
+        let w_on =
+            self.floor.rotating(k.w, wn, self.ang != [0; 3]) && wn >= REL_ACTIVE * self.w_peak;
         self.lin = signs(k.v, v_on, self.lin);
         self.ang = signs(k.w, w_on, self.ang);
         token_from_signs(self.lin, self.ang)
@@ -515,30 +535,51 @@ mod tests {
         }
     }
 
+    /// A tokenizer that has watched a clean tracker at rest for the stream's first noise
+    /// block, and the time of its next tick.
+    fn primed() -> (Tokenizer, u64) {
+        let mut tk = Tokenizer::new();
+        let mut t = 0;
+        for _ in 0..crate::noise::BLOCK_TICKS {
+            tk.step(&kin(t, [0.0; 3], [0.0; 3]));
+            t += TICK_US;
+        }
+        (tk, t)
+    }
+
+    #[test]
+    fn nothing_moves_while_the_sensor_is_being_learnt() {
+        let mut tk = Tokenizer::new();
+        let t = tk.raw_token(&kin(0, [0.0, 1.0, 1.0], [0.0; 3]));
+        assert_eq!(t, STILL);
+        let (mut tk, t0) = primed();
+        let t = tk.raw_token(&kin(t0, [0.0, 1.0, 1.0], [0.0; 3]));
+        assert_eq!(TokenName(t).to_string(), "uf");
+    }
+
     #[test]
     fn direction_not_size_decides_the_bin() {
         for scale in [0.1f32, 1.0, 10.0] {
-            let mut tk = Tokenizer::new();
-            let t = tk.raw_token(&kin(0, [0.0, 0.7 * scale, 0.7 * scale], [0.0; 3]));
+            let (mut tk, t0) = primed();
+            let t = tk.raw_token(&kin(t0, [0.0, 0.7 * scale, 0.7 * scale], [0.0; 3]));
             assert_eq!(TokenName(t).to_string(), "uf");
         }
-        let mut tk = Tokenizer::new();
+        let (mut tk, t0) = primed();
         // Noise-level rotation during a slide is not a rotation token.
-        let t = tk.raw_token(&kin(0, [0.0, 0.0, 0.5], [0.1, 0.2, 0.0]));
+        let t = tk.raw_token(&kin(t0, [0.0, 0.0, 0.5], [0.1, 0.2, 0.0]));
         assert_eq!(TokenName(t).to_string(), "f");
         // Tiny translation during a fast turn is not a translation token.
-        let t = tk.raw_token(&kin(10_000, [0.05, 0.0, 0.0], [0.0, 4.0, 0.0]));
+        let t = tk.raw_token(&kin(t0 + 10_000, [0.05, 0.0, 0.0], [0.0, 4.0, 0.0]));
         assert_eq!(TokenName(t).to_string(), ".Yp");
-        let t = tk.raw_token(&kin(20_000, [0.001, 0.0, 0.0], [0.0, 0.01, 0.0]));
+        let t = tk.raw_token(&kin(t0 + 20_000, [0.001, 0.0, 0.0], [0.0, 0.01, 0.0]));
         assert_eq!(t, STILL);
     }
 
     #[test]
     fn short_blips_are_suppressed() {
-        let mut tk = Tokenizer::new();
+        let (mut tk, mut t) = primed();
         let up = [0.0, 1.0, 0.0];
         let fwd = [0.0, 0.0, 1.0];
-        let mut t = 0;
         let mut feed = |tk: &mut Tokenizer, v, n: u64| {
             let mut out = std::vec::Vec::new();
             for _ in 0..n {
@@ -547,10 +588,12 @@ mod tests {
             }
             out
         };
-        assert!(matches!(
-            feed(&mut tk, up, 5)[0],
-            TokenStep::NewToken { .. }
-        ));
+        assert_eq!(
+            feed(&mut tk, up, 5)[3],
+            TokenStep::NewToken {
+                token: parse_token("u").unwrap()
+            }
+        );
         let blip = feed(&mut tk, fwd, 2);
         assert_eq!(blip, [TokenStep::Candidate, TokenStep::Candidate]);
         assert_eq!(
@@ -571,8 +614,7 @@ mod tests {
 
     #[test]
     fn a_quick_sweep_after_stillness_is_not_lost() {
-        let mut tk = Tokenizer::new();
-        let mut t = 0;
+        let (mut tk, mut t) = primed();
         let mut feed = |tk: &mut Tokenizer, v: [f32; 3], n: u64| {
             let mut out = std::vec::Vec::new();
             for _ in 0..n {

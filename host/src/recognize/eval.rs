@@ -12,22 +12,28 @@
 //!   precision, recall and F1, and why the unmatched events did not match ([`ExtraKind`]);
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
+//!
+//! Benchmarks: `figurine eval rest` ([`super::rest_bench`], false alarms per hour at rest) and
+//! `figurine eval sweep` ([`super::sweep`], accuracy as noise, rate or scale is swept).
 
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, Subcommand};
 
 use super::effort_train::{gesture_features, train, Example, Trained};
 use super::feed::{log_samples, recognize_log, Clock};
 use super::learn::learn_action;
 use super::library::LibraryFile;
+use super::rest_bench::RestBenchArgs;
 use super::simulate::load_effort;
-use crate::synth::{self, Action, Doodle, Knobs, Label, TimeClass, WeightClass};
+use super::sweep::SweepArgs;
+use crate::synth::{self, Action, Doodle, Knobs, Label, Range, TimeClass, WeightClass};
 use figurine_recognizer::{EffortModel, Library, Recognizer};
 
 /// Arguments of `figurine eval`.
 #[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct EvalArgs {
     /// Seed of the test set (use one nothing was trained on).
     #[arg(long, default_value_t = 1000)]
@@ -71,6 +77,47 @@ pub struct EvalArgs {
     /// the mean (with learning and training only, not with given files).
     #[arg(long, default_value_t = 1)]
     pub pairs: usize,
+    /// The tracker and player of every generated log, learning and test alike (a user records
+    /// examples with the tracker they play with): noise multiplier (default 0.5..1.5).
+    #[arg(long)]
+    pub noise: Option<Range>,
+    /// Nominal tracker rate, Hz (default 30..240).
+    #[arg(long)]
+    pub rate: Option<Range>,
+    /// Spatial scale of the doodles (default 0.5..2; 1 is an arm's-length doodle).
+    #[arg(long)]
+    pub scale: Option<Range>,
+    /// A benchmark instead of the accuracy tables.
+    #[command(subcommand)]
+    pub command: Option<EvalCommand>,
+}
+
+/// The benchmarks of `figurine eval`.
+#[derive(Subcommand, Debug, Clone)]
+pub enum EvalCommand {
+    /// False alarms per hour at rest: hours of a figurine held, set down or mounted, under
+    /// every tracker level, with the shipped library and libraries learnt from 3 examples.
+    Rest(RestBenchArgs),
+    /// Robustness: isolated accuracy and sequence F1 as the tracker's noise, its rate or the
+    /// doodle's scale is swept.
+    Sweep(SweepArgs),
+}
+
+impl EvalArgs {
+    /// The generator's knobs, with this evaluation's tracker and scale.
+    pub fn knobs(&self) -> Knobs {
+        let mut k = Knobs::default();
+        if let Some(r) = self.noise {
+            k.noise = r;
+        }
+        if let Some(r) = self.rate {
+            k.rate_hz = r;
+        }
+        if let Some(r) = self.scale {
+            k.scale = r;
+        }
+        k
+    }
 }
 
 /// Learns every synth action from `n` generated examples.
@@ -446,13 +493,18 @@ pub fn prepare(args: &EvalArgs, knobs: &Knobs) -> Result<(LibraryFile, EffortMod
 
 /// `figurine eval`.
 pub fn run(args: &EvalArgs) -> Result<()> {
+    match &args.command {
+        Some(EvalCommand::Rest(a)) => return super::rest_bench::run(a),
+        Some(EvalCommand::Sweep(a)) => return super::sweep::run(a),
+        None => {}
+    }
     if args.pairs == 0 {
         anyhow::bail!("--pairs must be at least 1");
     }
     if args.pairs > 1 {
         return super::eval_pairs::run(args);
     }
-    let knobs = Knobs::default();
+    let knobs = args.knobs();
     let (mut lib, effort) = prepare(args, &knobs)?;
     let f = evaluate(args, &mut lib, effort, &knobs)?;
     println!(

@@ -6,7 +6,6 @@
 use anyhow::{bail, Result};
 
 use super::eval::{evaluate, prepare, quantiles, EvalArgs, Figures};
-use crate::synth::Knobs;
 
 /// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
 pub const TEST_SEED_STEP: u64 = 1000;
@@ -86,7 +85,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
              --effort, --save-library or --save-effort"
         );
     }
-    let knobs = Knobs::default();
+    let knobs = args.knobs();
     let mut lines = Vec::new();
     let mut rows = Vec::new();
     for i in 0..args.pairs as u64 {
@@ -98,6 +97,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             effort: None,
             save_library: None,
             save_effort: None,
+            command: None,
             ..*args
         };
         let (mut lib, effort) = prepare(&pair, &knobs)?;

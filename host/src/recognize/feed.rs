@@ -6,12 +6,13 @@
 //! (including the wrap-extending time and sequence unwrappers). Samples the wire cannot carry
 //! (NaN, beyond ±100 m, zero quaternion) are dropped here and counted, as the link would.
 
+use anyhow::Result;
 use figurine_protocol::pose::{Pose, SeqUnwrapper, TimeUnwrapper};
 use figurine_recognizer::features::Accum;
 use figurine_recognizer::frontend::{FrontEvent, Frontend};
 use figurine_recognizer::history::Run;
 use figurine_recognizer::token::STILL;
-use figurine_recognizer::{ActionEvent, Recognizer, Sample};
+use figurine_recognizer::{ActionEvent, EffortModel, Library, Recognizer, Sample};
 
 use crate::events::fold_revision;
 use crate::poselog::PoseLog;
@@ -99,6 +100,25 @@ pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> V
     events
 }
 
+/// The events each library's recognizer reports on `log`, as [`recognize_log`] gives them
+/// (the log is quantised once and fed to every library; `eval rest` counts them).
+pub fn log_events(
+    log: &PoseLog,
+    blobs: &[&[u8]],
+    effort: EffortModel,
+) -> Result<Vec<Vec<ActionEvent>>> {
+    let (samples, _) = log_samples(log);
+    blobs
+        .iter()
+        .map(|blob| {
+            let lib = Library::from_bytes(blob)
+                .map_err(|e| anyhow::anyhow!("library blob refused: {e}"))?;
+            let mut rec = Recognizer::new(lib, Some(effort));
+            Ok(recognize_log(&mut rec, &samples))
+        })
+        .collect()
+}
+
 /// All token runs of a log (STILL included), in order, with their feature sums.
 pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
     let mut front = Frontend::new();
@@ -149,5 +169,41 @@ pub fn gesture_runs(runs: &[Run]) -> &[Run] {
     match (first, last) {
         (Some(a), Some(b)) => &runs[a..=b],
         _ => &[],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recognize::simulate::{load_effort, load_library};
+    use crate::synth::{gesture, rest_log, Action, Knobs, Range, RestKind, RestSpec, TrackerLevel};
+
+    fn shipped() -> (Vec<u8>, EffortModel) {
+        let (_, blob) = load_library(None).unwrap();
+        (blob, load_effort(None).unwrap())
+    }
+
+    #[test]
+    fn a_gesture_raises_an_event_and_a_table_rest_none() {
+        let (blob, effort) = shipped();
+        let d = gesture(
+            3,
+            &Knobs::canonical(),
+            Action::Jump,
+            "sudden-strong".parse().unwrap(),
+        );
+        let ev = log_events(&d.log, &[&blob], effort).unwrap();
+        assert!(!ev[0].is_empty(), "a jump raised no event");
+        let spec = RestSpec {
+            seconds: 120.0,
+            kind: Some(RestKind::Table),
+            tracker: TrackerLevel::by_name("lighthouse"),
+            rate_hz: Some(Range::fixed(240.0)),
+            knobs: Knobs::default(),
+        };
+        let r = rest_log(5, &spec);
+        let ev = log_events(&r.log, &[&blob, &blob], effort).unwrap();
+        assert_eq!(ev.len(), 2);
+        assert!(ev.iter().all(|e| e.is_empty()), "{ev:?}");
     }
 }

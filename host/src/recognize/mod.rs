@@ -7,7 +7,9 @@
 //! - [`dtw`] + [`learn`] + [`separate`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ `font`): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
-//! - [`eval`] (+ [`eval_pairs`]): `figurine eval`.
+//! - [`eval`] (+ [`eval_pairs`]): `figurine eval`; [`rest_bench`]: `figurine eval rest` (false
+//!   alarms per hour at rest); [`sweep`]: `figurine eval sweep` (robustness to noise, rate,
+//!   scale).
 
 pub mod dtw;
 pub mod effort_model;
@@ -19,6 +21,8 @@ pub mod learn;
 pub mod library;
 pub mod regex;
 pub mod report;
+pub mod rest_bench;
 pub mod separate;
 pub mod simulate;
+pub mod sweep;
 pub mod tokens;

@@ -1,4 +1,4 @@
-//! `figurine synth …`: the command-line face of the doodle generator.
+//! `figurine synth …`: the command-line face of the doodle generator (and of [`super::rest`]).
 
 use std::path::{Path, PathBuf};
 
@@ -8,6 +8,7 @@ use clap::{Args, Subcommand};
 use super::effort::Effort;
 use super::gesture::Action;
 use super::knobs::{Knobs, Range};
+use super::rest::{rest_log, RestKind, RestSpec, TrackerLevel};
 use super::sampling::SignMode;
 use super::sequence::{effort_set, examples, gesture, sequence, Doodle};
 
@@ -124,6 +125,39 @@ enum SynthCommand {
         #[command(flatten)]
         knobs: KnobArgs,
     },
+    /// A log of a figurine playing no action: held in a hand, on a table, or on a stand.
+    ///
+    /// hand: tremor (8-12 Hz, at most 3 mm and 0.5 deg per axis), sway (0.1-0.5 Hz, 1-5 mm,
+    /// 0.5-2 deg) and idle fidgets every few to tens of seconds (2-8 mm, 1-5 deg, 0.2-0.8 s).
+    /// table: only the tracker's noise and drift. mounted: plus a 0.05-0.2 mm stand vibration
+    /// at 20-50 Hz. Prints one summary line; --labels writes everything drawn as JSON.
+    Rest {
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output pose log (CSV).
+        #[arg(long)]
+        out: PathBuf,
+        /// Length of the log, seconds (at most 3600).
+        #[arg(long, default_value_t = 600.0)]
+        seconds: f64,
+        /// hand, table, mounted, or random.
+        #[arg(long, default_value = "random")]
+        kind: KindArg,
+        /// Tracker level: lighthouse (Lighthouse/optical mocap: 0.1-0.3 mm, 0.02-0.05 deg,
+        /// 120-1000 Hz), imu-fusion (IMU + optical/UWB: 0.5-1 mm, 0.1-0.2 deg, 100-400 Hz),
+        /// webcam-near (tag at 0.5 m: 0.5-1 mm across, 1-2 mm in depth, 0.2-0.3 deg, 30-60 Hz),
+        /// webcam-far (tag at 1 m: 1-2 mm across, 2.5-5 mm in depth, 0.3-0.5 deg, 30 Hz), or
+        /// random.
+        #[arg(long, default_value = "random")]
+        tracker: TrackerArg,
+        /// Sample rate, Hz: `V` or `LO..HI` [default: the tracker level's].
+        #[arg(long, allow_hyphen_values = true)]
+        rate: Option<Range>,
+        /// Also write what was drawn (kind, tracker, sigmas, rate, fidget times) as JSON here.
+        #[arg(long)]
+        labels: Option<PathBuf>,
+    },
     /// Draw a pose log as a PNG: top view, side view, speeds over time, label spans.
     Plot {
         /// The pose log (CSV).
@@ -149,6 +183,43 @@ impl std::str::FromStr for EffortArg {
         } else {
             s.parse().map(|e| Self(Some(e)))
         }
+    }
+}
+
+/// `random` or a rest kind.
+#[derive(Debug, Clone, Copy)]
+struct KindArg(Option<RestKind>);
+
+impl std::str::FromStr for KindArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("random") {
+            Ok(Self(None))
+        } else {
+            s.parse().map(|k| Self(Some(k)))
+        }
+    }
+}
+
+/// `random` or a tracker level of [`TRACKER_LEVELS`](super::rest::TRACKER_LEVELS).
+#[derive(Debug, Clone, Copy)]
+struct TrackerArg(Option<TrackerLevel>);
+
+impl std::str::FromStr for TrackerArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("random") {
+            return Ok(Self(None));
+        }
+        TrackerLevel::by_name(s)
+            .map(|l| Self(Some(l)))
+            .ok_or_else(|| {
+                format!(
+                    "unknown tracker level `{}`: expected {} or random",
+                    s.trim(),
+                    TrackerLevel::names()
+                )
+            })
     }
 }
 
@@ -237,10 +308,16 @@ impl KnobArgs {
     }
 }
 
-fn write_doodle(d: &Doodle, out: &Path) -> Result<()> {
+/// Creates the folder `out` goes in, if it has one.
+fn make_parent(out: &Path) -> Result<()> {
     if let Some(dir) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
+    Ok(())
+}
+
+fn write_doodle(d: &Doodle, out: &Path) -> Result<()> {
+    make_parent(out)?;
     d.write_csv(out)
         .with_context(|| format!("writing {}", out.display()))
 }
@@ -416,6 +493,44 @@ pub fn run(args: SynthArgs) -> Result<()> {
                 .save(&out)
                 .with_context(|| format!("writing {}", out.display()))?;
             say(format_args!("{}", out.display()));
+        }
+        SynthCommand::Rest {
+            seed,
+            out,
+            seconds,
+            kind,
+            tracker,
+            rate,
+            labels,
+        } => {
+            let spec = RestSpec {
+                seconds,
+                kind: kind.0,
+                tracker: tracker.0,
+                rate_hz: rate,
+                knobs: Knobs::default(),
+            };
+            spec.validate().map_err(anyhow::Error::msg)?;
+            let r = rest_log(seed, &spec);
+            make_parent(&out)?;
+            r.write_csv(&out)
+                .with_context(|| format!("writing {}", out.display()))?;
+            if let Some(l) = labels {
+                make_parent(&l)?;
+                r.write_info(&l)
+                    .with_context(|| format!("writing {}", l.display()))?;
+            }
+            let s = &r.log.samples;
+            let (t0, t1) = match (s.first(), s.last()) {
+                (Some(a), Some(b)) => (a.t, b.t),
+                _ => (0.0, 0.0),
+            };
+            say(format_args!(
+                "{}: {} samples, {t0:.3}..{t1:.3} s, {}",
+                out.display(),
+                s.len(),
+                r.info
+            ));
         }
         SynthCommand::Plot { log, labels, out } => {
             super::plot::plot_files(&log, labels.as_deref(), &out)?;

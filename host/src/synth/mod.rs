@@ -22,7 +22,10 @@
 //! acceleration separates them without knowing the doodle's scale. Impacts need ≳ 60 Hz to be
 //! seen; at 30 Hz Weight shows mostly through amplitude and speed.
 //!
-//! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot` (see
+//! [`rest`] makes logs of a figurine that plays *no* action — held in a hand, set on a table,
+//! or mounted on a stand — under a chosen tracker level, for false-positive checks.
+//!
+//! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot|rest` (see
 //! [`cli`]). Library use (in-process, no files):
 //! ```
 //! use figurine_host::synth::{gesture, Action, Effort, Knobs};
@@ -37,6 +40,7 @@ pub mod gesture;
 pub mod knobs;
 pub mod noise;
 pub mod plot;
+pub mod rest;
 pub mod rng;
 pub mod sampling;
 pub mod sequence;
@@ -45,4 +49,5 @@ pub mod trajectory;
 pub use effort::{Effort, TimeClass, WeightClass};
 pub use gesture::Action;
 pub use knobs::{Knobs, Range, Variation};
+pub use rest::{rest_log, RestKind, RestLog, RestSpec, TrackerLevel, TRACKER_LEVELS};
 pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label, Performer};

@@ -24,21 +24,23 @@ const TREMOR_PARTIALS: usize = 2;
 /// Number of sinusoidal partials of positional drift per axis.
 const DRIFT_PARTIALS: usize = 3;
 
+/// One sinusoid `amp·sin(2π·freq·t + phase)` (units of `amp`; `freq` in Hz, `phase` radians);
+/// shared with [`super::rest`], whose hand and stand motions are made of the same stuff.
 #[derive(Debug, Clone, Copy, Default)]
-struct Partial {
-    amp: f64,
-    freq: f64,
-    phase: f64,
+pub(super) struct Partial {
+    pub(super) amp: f64,
+    pub(super) freq: f64,
+    pub(super) phase: f64,
 }
 
 impl Partial {
-    fn at(&self, t: f64) -> f64 {
+    pub(super) fn at(&self, t: f64) -> f64 {
         self.amp * (TAU * self.freq * t + self.phase).sin()
     }
 }
 
 /// Draws `n` partials per axis for 3 axes; amplitudes split so their sum peaks near `amp`.
-fn partials<const N: usize>(
+pub(super) fn partials<const N: usize>(
     rng: &mut SynthRng,
     amp: f64,
     f_lo: f64,
@@ -55,7 +57,7 @@ fn partials<const N: usize>(
     out
 }
 
-fn eval3<const N: usize>(ps: &[[Partial; N]; 3], t: f64) -> DVec3 {
+pub(super) fn eval3<const N: usize>(ps: &[[Partial; N]; 3], t: f64) -> DVec3 {
     let axis = |a: &[Partial; N]| a.iter().map(|p| p.at(t)).sum::<f64>();
     DVec3::new(axis(&ps[0]), axis(&ps[1]), axis(&ps[2]))
 }

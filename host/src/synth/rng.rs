@@ -22,6 +22,8 @@ pub enum Stream {
     Sensor,
     /// The sample clock: timestamp jitter and dropped samples.
     Clock,
+    /// `synth rest`: kind of rest, tracker level, hand motion and fidgets.
+    Rest,
 }
 
 impl Stream {
@@ -31,6 +33,7 @@ impl Stream {
             Stream::Plan => 0x706c_616e,
             Stream::Sensor => 0x7365_6e73,
             Stream::Clock => 0x636c_6f63,
+            Stream::Rest => 0x7265_7374,
         }
     }
 }

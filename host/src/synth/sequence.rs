@@ -77,7 +77,7 @@ impl Doodle {
 
 /// Rounds a time to whole microseconds: the resolution of the CSV clock and of the wire, so
 /// in-process doodles, written logs and labels all carry the same instants.
-fn to_micros(t: f64) -> f64 {
+pub(super) fn to_micros(t: f64) -> f64 {
     (t * 1e6).round() / 1e6
 }
 
