@@ -22,6 +22,7 @@ use image::{Rgb, RgbImage};
 
 use super::effort::{TimeClass, WeightClass};
 use super::sequence::Label;
+use crate::chart::nice_step;
 use crate::poselog::PoseLog;
 use crate::raster::{draw_text, text_width};
 
@@ -420,19 +421,6 @@ fn short_weight(w: WeightClass) -> &'static str {
         WeightClass::Light => "LIGHT",
         WeightClass::Neutral => "NEUTRAL",
     }
-}
-
-/// The round number (1, 2 or 5 × 10^k) nearest above `x`.
-fn nice_step(x: f64) -> f64 {
-    if !(x.is_finite() && x > 0.0) {
-        return 1.0;
-    }
-    let p = 10f64.powf(x.log10().floor());
-    [1.0, 2.0, 5.0, 10.0]
-        .into_iter()
-        .map(|m| m * p)
-        .find(|v| *v >= x)
-        .unwrap_or(10.0 * p)
 }
 
 /// Reads a pose log (and labels JSON), plots it, and writes the PNG.
