@@ -44,6 +44,7 @@ pub mod rest;
 pub mod rng;
 pub mod sampling;
 pub mod sequence;
+pub mod tracker;
 pub mod trajectory;
 
 pub use effort::{Effort, TimeClass, WeightClass};
