@@ -150,7 +150,8 @@ impl Channel {
     /// Whether the vector has lately gone somewhere: its running mean velocity is at least
     /// [`HEADING_SHARE`] of its running mean speed (tremor and jitter go to and fro).
     fn heading(&self) -> bool {
-        fmath::norm3(self.mean_v) >= HEADING_SHARE * self.mean_speed
+        let reach = HEADING_SHARE * self.mean_speed;
+        fmath::dot3(self.mean_v, self.mean_v) >= reach * reach
     }
 
     /// Whether the block went nowhere: its net motion stayed below [`COHERENCE_MAX`] of its
@@ -199,8 +200,9 @@ impl Channel {
     /// along that direction only.
     fn moves(&self, v: [f32; 3], norm: f32, moving: bool) -> bool {
         let k = if moving { OFF_FACTOR } else { ON_FACTOR };
-        let loud = self.inverse.is_none_or(|m| quadratic(&m, v) >= 3.0 * k * k);
-        norm >= self.least && loud && (moving || self.heading())
+        norm >= self.least
+            && self.inverse.is_none_or(|m| quadratic(&m, v) >= 3.0 * k * k)
+            && (moving || self.heading())
     }
 
     /// The noise rms (same unit as the vector).
@@ -238,8 +240,8 @@ impl NoiseFloor {
         }
     }
 
-    /// Feeds one tick: world velocity `v` (m/s, norm `vn`; a tracker's noise is fixed in the
-    /// world) and object-frame angular velocity `w` (rad/s, norm `wn`).
+    /// Feeds one tick: world velocity `v` (m/s; a tracker's noise is fixed in the world) with
+    /// its norm `vn`, and object-frame angular velocity `w` (rad/s) with its norm `wn`.
     pub fn push(&mut self, v: [f32; 3], vn: f32, w: [f32; 3], wn: f32) {
         self.lin.add(v, vn);
         self.ang.add(w, wn);

@@ -391,11 +391,9 @@ impl Tokenizer {
         let wn = fmath::norm3(k.w);
         self.v_peak = fmath::max(vn, self.v_peak * PEAK_DECAY);
         self.w_peak = fmath::max(wn, self.w_peak * PEAK_DECAY);
-        let world_vn = fmath::norm3(k.world_v);
-        self.floor.push(k.world_v, world_vn, k.w, wn);
-        let v_on = self
-            .floor
-            .translating(k.world_v, world_vn, self.lin != [0; 3])
+        // A rotation keeps the norm: the object-frame speed is the world speed.
+        self.floor.push(k.world_v, vn, k.w, wn);
+        let v_on = self.floor.translating(k.world_v, vn, self.lin != [0; 3])
             && vn >= REL_ACTIVE * self.v_peak
             && vn >= ARM_M * wn;
         let w_on =
