@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | 1 | ticks are grouped into blocks of [`BLOCK_TICKS`] (0.25 s); a block's power is its mean v vᵀ | a pause between strokes is a block of its own |
 //! | 2 | a block counts as noise only if both vectors went nowhere: \|Σv\| < [`COHERENCE_MAX`] × Σ\|v\| | jitter and tremor go to and fro, a stroke or a spin goes somewhere, whatever the tracker: a gesture is not learnt as noise |
-//! | 3 | the noise is the counted block of median power among the last [`BLOCKS`] counted ones | robust to a stray counted block of a gesture, unbiased at 30 Hz as at 1000 Hz |
+//! | 3 | the noise is the counted block of median power among the last [`BLOCKS`] counted ones | robust to a stray counted block of a gesture; less biased than the least block where a block holds few independent samples (30 Hz) |
 //! | 4 | a vector starts moving when vᵀ C⁻¹ v ≥ 3 × [`ON_FACTOR`]² (\|v\| ≥ [`ON_FACTOR`] × rms for noise alike on all axes) and it heads somewhere (running mean velocity ≥ [`HEADING_SHARE`] × running mean speed); it stays moving down to [`OFF_FACTOR`] | two thresholds (hysteresis); a webcam's depth jitter needs more along the depth only |
 //!
 //! The fixed floors [`V_FLOOR_M_S`] and [`W_FLOOR_RAD_S`] stay as lower bounds; the token's
@@ -171,14 +171,18 @@ impl Channel {
                 }
             }
             let trace = |c: &Sym3| c[0] + c[1] + c[2];
-            let known = self.recent.iter().filter(|c| trace(c).is_finite()).count();
+            let known = self
+                .recent
+                .iter()
+                .filter(|c| fmath::is_finite(trace(c)))
+                .count();
             // The lower median by power: the rank-th smallest, counting ties once each.
             let rank = known.saturating_sub(1) / 2;
             let mut median = self.noise;
             for c in &self.recent {
                 let t = trace(c);
                 let below = self.recent.iter().filter(|d| trace(d) < t).count();
-                if t.is_finite()
+                if fmath::is_finite(t)
                     && below <= rank
                     && below + self.recent.iter().filter(|d| trace(d) == t).count() > rank
                 {

@@ -84,7 +84,7 @@ pub struct EvalArgs {
     /// Nominal tracker rate, Hz (default 30..240).
     #[arg(long)]
     pub rate: Option<Range>,
-    /// Spatial scale of the doodles (default 0.5..2; 1 is an arm's-length doodle).
+    /// Spatial scale of the doodles (default 0.5..2; at 1 a gesture is about 14 cm across).
     #[arg(long)]
     pub scale: Option<Range>,
     /// A benchmark instead of the accuracy tables.
