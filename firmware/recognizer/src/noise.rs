@@ -170,25 +170,25 @@ impl Channel {
                     *r = p / f32::from(BLOCK_TICKS);
                 }
             }
-            let trace = |c: &Sym3| c[0] + c[1] + c[2];
-            let known = self
-                .recent
+            let trace = |i: usize| {
+                self.recent
+                    .get(i)
+                    .map_or(f32::INFINITY, |c| c[0] + c[1] + c[2])
+            };
+            // Blocks by power (uncounted slots, infinite, last; ties by slot, so the order is
+            // one and the same on every target); the noise is the lower median.
+            let mut order: [usize; BLOCKS] = core::array::from_fn(|i| i);
+            order.sort_unstable_by(|&a, &b| trace(a).total_cmp(&trace(b)).then(a.cmp(&b)));
+            let known = order
                 .iter()
-                .filter(|c| fmath::is_finite(trace(c)))
+                .filter(|&&i| fmath::is_finite(trace(i)))
                 .count();
-            // The lower median by power: the rank-th smallest, counting ties once each.
             let rank = known.saturating_sub(1) / 2;
-            let mut median = self.noise;
-            for c in &self.recent {
-                let t = trace(c);
-                let below = self.recent.iter().filter(|d| trace(d) < t).count();
-                if fmath::is_finite(t)
-                    && below <= rank
-                    && below + self.recent.iter().filter(|d| trace(d) == t).count() > rank
-                {
-                    median = *c;
-                }
-            }
+            let median = order
+                .get(rank)
+                .and_then(|&i| self.recent.get(i))
+                .copied()
+                .unwrap_or(self.noise);
             self.noise = median;
             self.inverse = regularised_inverse(&median);
         }

@@ -366,11 +366,6 @@ impl Tokenizer {
         };
     }
 
-    /// The learnt noise floor.
-    pub fn noise_floor(&self) -> &NoiseFloor {
-        &self.floor
-    }
-
     /// The token seen most often among the swept ticks (the later one on a tie).
     fn sweep_mode(&self) -> Option<Token> {
         let seen = self.sweep.get(..self.swept)?;
