@@ -22,7 +22,7 @@ use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 
-use super::eval::{evaluate, learn_synth_library, train_synth_effort, EvalArgs};
+use super::eval::{evaluate, prepare, EvalArgs};
 use super::eval_pairs::{PairLine, TEST_SEED_STEP};
 use crate::chart::{line_chart, save_png, LineChart, LinePanel};
 use crate::synth::Range;
@@ -185,15 +185,11 @@ fn spread(v: impl Iterator<Item = f64> + Clone) -> (f64, f64, f64) {
 }
 
 /// One pair's evaluation: learn and train at its train seed with the pinned knob, test at its
-/// test seed — what `figurine eval` does without `--library` / `--effort`, minus the printing.
+/// test seed — what `figurine eval` does without `--library` / `--effort`.
 fn evaluate_pair(args: &EvalArgs) -> Result<PairLine> {
     let knobs = args.knobs();
     knobs.validate().map_err(anyhow::Error::msg)?;
-    let mut lib = learn_synth_library(args.train_seed, args.examples, &knobs)?;
-    let effort = train_synth_effort(args.train_seed, args.effort_per_class, &knobs)?
-        .1
-        .file
-        .model()?;
+    let (mut lib, effort) = prepare(args, &knobs)?;
     Ok(PairLine::of(&evaluate(args, &mut lib, effort, &knobs)?))
 }
 
