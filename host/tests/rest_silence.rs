@@ -3,10 +3,13 @@
 //! wire quantisation and the shipped library.
 
 use figurine_host::link::blobs::{self, Blobs};
+use figurine_host::poselog::PoseLog;
+use figurine_host::recognize::library::LibraryFile;
 use figurine_host::recognize::simulate::simulate_log;
 use figurine_host::synth::knobs::{Knobs, Range};
 use figurine_host::synth::{
-    gesture, rest_log, Action, Effort, RestKind, RestSpec, TimeClass, WeightClass, TRACKER_LEVELS,
+    gesture, rest_log, Action, Effort, RestKind, RestSpec, TimeClass, TrackerLevel, WeightClass,
+    TRACKER_LEVELS,
 };
 use figurine_recognizer::EffortModel;
 
@@ -16,14 +19,14 @@ fn shipped() -> (Blobs, EffortModel) {
     (b, e)
 }
 
-/// A minute of every kind of rest under every tracker level: a figurine that does not move
-/// gives no event, and one held in a hand gives none but where the hand fidgeted (a real
-/// motion of a few millimetres and degrees, which only a per-action bound on how far a
-/// performance may stray can tell from a gesture).
+/// A minute of every kind of rest under every tracker level gives no event: a figurine that
+/// does not move has only the tracker's noise, which the learnt noise floor keeps from being
+/// motion; one held in a hand also fidgets, a real motion of a few millimetres and degrees
+/// that may spell an action's tokens but goes nowhere near as far as its examples went.
 #[test]
-fn rest_under_every_tracker_gives_no_event_but_at_a_fidget() {
+fn rest_under_every_tracker_gives_no_event() {
     let (b, effort) = shipped();
-    let mut fidget_events = 0;
+    let mut fidgets = 0;
     for (i, level) in TRACKER_LEVELS.iter().enumerate() {
         for kind in [RestKind::Table, RestKind::Mounted, RestKind::Hand] {
             let seed = 100 + i as u64;
@@ -36,26 +39,79 @@ fn rest_under_every_tracker_gives_no_event_but_at_a_fidget() {
                     ..RestSpec::default()
                 },
             );
+            fidgets += rest.info.fidgets.len();
             let sim = simulate_log(&rest.log, &b.names, &b.library, Some(effort)).unwrap();
-            for r in &sim.records {
-                let at_fidget = rest
-                    .info
-                    .fidgets
-                    .iter()
-                    .any(|f| r.start < f.end + 0.3 && r.end > f.start - 0.3);
-                assert!(
-                    kind == RestKind::Hand && at_fidget,
-                    "{} at {:.2}-{:.2} s on {kind:?} rest under {} (seed {seed}), no fidget there",
-                    r.action,
-                    r.start,
-                    r.end,
-                    level.name
+            if let Some(r) = sim.records.first() {
+                panic!(
+                    "{} at {:.2}-{:.2} s on {kind:?} rest under {} (seed {seed})",
+                    r.action, r.start, r.end, level.name
                 );
-                fidget_events += 1;
             }
         }
     }
-    eprintln!("events at fidgets: {fidget_events}");
+    // The hands did fidget.
+    assert!(fidgets >= TRACKER_LEVELS.len(), "{fidgets} fidgets");
+}
+
+/// Hand rests on which the shipped library, before it learnt how far its examples went,
+/// read a fidget as an action (`figurine eval rest --verbose`): the rest's seed, its tracker,
+/// when the fidget's event began (s), and the action it was read as.
+const FIDGETS_ONCE_READ: [(u64, &str, f64, &str); 3] = [
+    (6_854_274_470_864_460_927, "lighthouse", 22.44, "turn"),
+    (16_958_851_266_643_440_245, "lighthouse", 121.04, "bow"),
+    (2_724_813_854_111_988_808, "imu-fusion", 115.41, "wave"),
+];
+
+/// The shipped library's actions as they are, and without their learnt extents.
+fn with_and_without_extents() -> (Blobs, Vec<u8>) {
+    let (b, _) = shipped();
+    let mut bare = LibraryFile::default_library().unwrap();
+    for a in &mut bare.actions {
+        a.extent = None;
+    }
+    let blob = bare.blob().unwrap();
+    (b, blob)
+}
+
+#[test]
+fn fidgets_that_spell_an_action_are_no_action() {
+    let (b, bare) = with_and_without_extents();
+    let (_, effort) = shipped();
+    for (seed, tracker, at, action) in FIDGETS_ONCE_READ {
+        let rest = rest_log(
+            seed,
+            &RestSpec {
+                seconds: 300.0,
+                kind: Some(RestKind::Hand),
+                tracker: TrackerLevel::by_name(tracker),
+                ..RestSpec::default()
+            },
+        );
+        // Ten seconds of the rest up to the fidget, and five after it.
+        let log = PoseLog {
+            samples: rest
+                .log
+                .samples
+                .iter()
+                .filter(|s| s.t > at - 10.0 && s.t < at + 5.0)
+                .copied()
+                .collect(),
+        };
+        let read = |blob: &[u8]| {
+            simulate_log(&log, &b.names, blob, Some(effort))
+                .unwrap()
+                .records
+                .iter()
+                .map(|r| r.action.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            read(&bare),
+            [action],
+            "the fidget at {at} s spells `{action}`"
+        );
+        assert_eq!(read(&b.library), Vec::<String>::new(), "seed {seed}");
+    }
 }
 
 /// The decision latency (s) of the first event, and its action.

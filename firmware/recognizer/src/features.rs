@@ -83,7 +83,27 @@ pub const QUANTITY_NAMES: [&str; QUANTITIES] = [
     "ang.slowdown",
 ];
 
-/// Sums over a set of ticks, in order. 244 bytes.
+/// World displacement one unit of [`Accum::moved`] stands for, m (0.05 mm: a run of ±1.6 m).
+pub const MOVED_UNIT_M: f32 = 5.0e-5;
+/// Rotation one unit of [`Accum::turned`] stands for, rad (0.5 mrad: a run of ±16 rad).
+pub const TURNED_UNIT_RAD: f32 = 5.0e-4;
+
+/// 1.5 × 2²³: adding and then subtracting it leaves a float of magnitude under 2²² rounded to
+/// the nearest integer (ties to even), in two plain additions.
+const ROUNDER: f32 = 12_582_912.0;
+
+/// `x` × `per_unit`, rounded to the nearest integer: the units of `x`, saturating at the ends
+/// of `i16` (NaN is 0).
+#[inline(always)]
+fn units(x: f32, per_unit: f32) -> i16 {
+    // Six times a tick, so cheap on the MCU: two additions rather than a call to `roundf`, a
+    // cast to i32 (one saturating instruction) and a clamp (one more) rather than a cast to
+    // i16 (three comparisons).
+    let n = ((x * per_unit + ROUNDER) - ROUNDER) as i32;
+    n.clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16
+}
+
+/// Sums over a set of ticks, in order. 256 bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accum {
     /// Number of ticks.
@@ -97,6 +117,14 @@ pub struct Accum {
     /// Σ over the ticks of the height after each, above where the first began, m·ticks:
     /// whether the motion went up and came back (a jump) or down and came back (a crouch).
     pub lift: f32,
+    /// World displacement over the ticks of motion ([`Accum::travel`]), [`MOVED_UNIT_M`]
+    /// (each tick rounded, saturating): with [`Accum::turned`], how far a gesture went
+    /// ([`crate::extent`]). Fixed point keeps the 40 runs of the history within the RAM
+    /// budget.
+    pub moved: [i16; 3],
+    /// Rotation over the ticks of motion about the object's axes, [`TURNED_UNIT_RAD`] (each
+    /// tick rounded, saturating).
+    pub turned: [i16; 3],
 }
 
 impl Default for Accum {
@@ -114,6 +142,8 @@ impl Accum {
             sum_sq: [0.0; QUANTITIES],
             rise: 0.0,
             lift: 0.0,
+            moved: [0; 3],
+            turned: [0; 3],
         }
     }
 
@@ -129,6 +159,19 @@ impl Accum {
         }
     }
 
+    /// Adds how far a tick of motion carried the figurine: its world velocity `v` (m/s) and
+    /// its angular velocity `w` about its own axes (rad/s), over one tick. The front end calls
+    /// it for the ticks of moving runs only: a still run's drift is the tracker's and the
+    /// hand's, not the gesture's (and it spares the MCU the work on most ticks).
+    pub fn travel(&mut self, v: [f32; 3], w: [f32; 3]) {
+        for k in 0..3 {
+            let moved = units(v[k], TICK_S / MOVED_UNIT_M);
+            let turned = units(w[k], TICK_S / TURNED_UNIT_RAD);
+            self.moved[k] = self.moved[k].saturating_add(moved);
+            self.turned[k] = self.turned[k].saturating_add(turned);
+        }
+    }
+
     /// Adds another accumulator, whose ticks came after these.
     // Out of line: merges happen at run joins and commits, not per tick, and each inlined
     // copy costs flash.
@@ -136,6 +179,10 @@ impl Accum {
     pub fn merge(&mut self, o: &Accum) {
         append_height(&mut self.rise, &mut self.lift, o);
         self.n = self.n.saturating_add(o.n);
+        for k in 0..3 {
+            self.moved[k] = self.moved[k].saturating_add(o.moved[k]);
+            self.turned[k] = self.turned[k].saturating_add(o.turned[k]);
+        }
         for i in 0..QUANTITIES {
             if let (Some(s), Some(s2), Some(x), Some(x2)) = (
                 self.sum.get_mut(i),

@@ -10,10 +10,10 @@
 
 use crate::features::{Accum, FeatureExtractor};
 use crate::filter::SavGol;
-use crate::frame::kinematics;
+use crate::frame::{kinematics, Kinematics};
 use crate::history::History;
 use crate::intake::{Accept, Intake, IntakeCounters, Sample};
-use crate::token::{Token, TokenStep, Tokenizer};
+use crate::token::{Token, TokenStep, Tokenizer, STILL};
 
 /// What one sample did to the run structure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,13 +102,14 @@ impl Frontend {
             self.ticks = self.ticks.saturating_add(1);
             self.last_tick_us = k.tick.t_us;
             match self.tokenizer.step(&k) {
-                TokenStep::Run => self.extend_current(&q, rise, at),
+                TokenStep::Run => self.extend_current(&q, rise, &k, at),
                 TokenStep::Candidate => {
                     if self.cand.n == 0 {
                         self.cand_start = at;
                     }
                     self.cand_end = at;
                     self.cand.add(&q, rise);
+                    self.cand.travel(k.world_v, k.w);
                 }
                 TokenStep::BlipMerged { starts_candidate } => {
                     let blip = core::mem::take(&mut self.cand);
@@ -121,14 +122,18 @@ impl Frontend {
                         self.cand_start = at;
                         self.cand_end = at;
                         self.cand.add(&q, rise);
+                        self.cand.travel(k.world_v, k.w);
                     } else {
-                        self.extend_current(&q, rise, at);
+                        self.extend_current(&q, rise, &k, at);
                     }
                 }
                 TokenStep::NewToken { token } => {
                     let start = if self.cand.n > 0 { self.cand_start } else { at };
                     let mut acc = core::mem::take(&mut self.cand);
                     acc.add(&q, rise);
+                    if token != STILL {
+                        acc.travel(k.world_v, k.w);
+                    }
                     let index = self.history.open(token, start, acc);
                     if let Some(r) = self.history.newest_mut() {
                         r.end = at;
@@ -143,10 +148,14 @@ impl Frontend {
         &mut self,
         q: &[f32; crate::features::QUANTITIES],
         rise: f32,
+        k: &Kinematics,
         at: (u32, u64),
     ) {
         if let Some(r) = self.history.newest_mut() {
             r.acc.add(q, rise);
+            if r.token != STILL {
+                r.acc.travel(k.world_v, k.w);
+            }
             r.end = at;
         }
     }

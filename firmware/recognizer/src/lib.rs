@@ -12,7 +12,8 @@
 //! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
 //! tokens cost half) → [`segment`] (online decision; stand-alone gestures no action matched
 //! given to their [`nearest`] action; a match right after an event may be its next piece,
-//! its rest or its settling: [`follow`]) →
+//! its rest or its settling: [`follow`]; a new event only when it went as far as its
+//! action's examples, not a fidget: [`extent`]) →
 //! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
@@ -23,7 +24,7 @@
 //! | [`pattern::MAX_ACTIONS`] | 32 actions | 64 B of record offsets (patterns stay in flash) |
 //! | [`pattern::MAX_POSITIONS`] | 32 tokens per pattern | blob ≤ [`pattern::MAX_LIBRARY_BYTES`] (flash) |
 //! | [`pattern::MAX_EDITS`] | 3 edits per action | 32 × 7 × 8 B = 1.75 KiB of automaton state (half-edit levels) |
-//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 10.6 KiB (features per run) |
+//! | [`history::HISTORY_RUNS`] | 40 token runs | ≈ 11.6 KiB (features per run) |
 //! | [`filter::SG_WINDOW`] | 11 ticks (110 ms) | ≈ 0.6 KiB |
 //! | [`token::SWEEP_TICKS`] | 8 ticks of a quick stroke after stillness | 16 B |
 //! | [`bayes::MAX_EFFORT_FEATURES`] | 16 per axis | ≈ 0.6 KiB; blob ≤ [`bayes::MAX_EFFORT_BYTES`] |
@@ -45,6 +46,7 @@ extern crate std;
 pub mod alignment;
 pub mod automaton;
 pub mod bayes;
+pub mod extent;
 pub mod features;
 pub mod filter;
 pub mod fmath;

@@ -8,9 +8,10 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (5; versions 4, 3 and 2, whose shape tables have only
-//!         the first 7, 6 and 4 bytes of each entry, and version 1, without the table, are
-//!         still read — their shapes are not used)
+//! 0   4   magic "FGL" + version byte (6; version 5, whose shape table has only the first 13
+//!         bytes of each entry, is still read and its extents are not known; versions 4, 3 and
+//!         2, with only 7, 6 and 4 bytes, and version 1, without the table, are still read —
+//!         their shapes are not used)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
 //! 5   3   reserved, zero
 //! then n_actions records, each 36 + 2·n + 8·(n + 1) bytes:
@@ -25,11 +26,11 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 13 bytes per action in record order (the mean of its examples'
-//! shapes, `features::Shape`, and how far they lay from it):
+//! then the shape table, 15 bytes per action in record order (the mean of its examples'
+//! shapes, `features::Shape`, how far they lay from it, and how far the least of them went):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
-//! +3  1   0 = shape unknown (all thirteen bytes are zero); otherwise shape known (learnt
+//! +3  1   0 = shape unknown (all fifteen bytes are zero); otherwise shape known (learnt
 //!         from examples; the host writes 1)
 //! +4  1   ln(1 + angle turned, rad) × 255 / SHAPE_TURN_MAX, rounded
 //! +5  1   share of the time spent still × 255, rounded
@@ -37,11 +38,16 @@
 //! +7  6   tolerance of each of the six dimensions above, in their order: the largest
 //!         `segment::SHAPE_SCALE`-weighted |example − mean| (at least the learner's floor),
 //!         × 255 rounded, at most 255
+//! +13 1   the least farthest displacement among the examples (`extent::Extent`), code
+//!         `extent::to_byte` in `extent::MOVED_CODE_UNIT_M`; 0 = not known
+//! +14 1   the least farthest rotation among them, code in `extent::TURNED_CODE_UNIT_RAD`;
+//!         0 = not known (both are known or neither)
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
 //! follow(i)` cost a few instructions for the mostly-sequential learnt patterns.
 
+use crate::extent::{from_byte, Extent, MOVED_CODE_UNIT_M, TURNED_CODE_UNIT_RAD};
 use crate::features::{Shape, SHAPE_DIMS};
 use crate::token::{symbol_matches, symbol_valid, Symbol, Token, STILL};
 use crate::Error;
@@ -53,9 +59,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 5;
+pub const LIBRARY_VERSION: u8 = 6;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 13;
+pub const SHAPE_BYTES: usize = 15;
+/// Bytes per action in a version 5 shape table (no extents).
+const SHAPE_BYTES_V5: usize = 13;
+/// Offset of the extents in a shape-table entry.
+const SHAPE_EXTENT_AT: usize = 13;
 /// Bytes per action in a version 4 shape table (one spread for all dimensions).
 const SHAPE_BYTES_V4: usize = 7;
 /// Offset of the tolerances in a shape-table entry.
@@ -72,7 +82,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,072).
+/// Largest valid library blob, bytes (12,136).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -224,9 +234,11 @@ pub struct Library<'a> {
     bytes: &'a [u8],
     n: usize,
     offsets: [u16; MAX_ACTIONS],
-    /// Offset of the shape table (0: none — a version 1 blob, or a version 2 or 3 one, whose
-    /// shapes lack dimensions and are not used).
+    /// Offset of the shape table (0: none — a version 1 blob, or a version 2, 3 or 4 one,
+    /// whose shapes lack dimensions or tolerances and are not used).
     shapes: u16,
+    /// Bytes per entry of the shape table ([`SHAPE_BYTES`], or a version 5 table's 13).
+    stride: u8,
 }
 
 impl<'a> Library<'a> {
@@ -237,6 +249,7 @@ impl<'a> Library<'a> {
             n: 0,
             offsets: [0; MAX_ACTIONS],
             shapes: 0,
+            stride: 0,
         }
     }
 
@@ -280,6 +293,7 @@ impl<'a> Library<'a> {
             2 => SHAPE_BYTES_V2,
             3 => SHAPE_BYTES_V3,
             4 => SHAPE_BYTES_V4,
+            5 => SHAPE_BYTES_V5,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -289,8 +303,14 @@ impl<'a> Library<'a> {
                 if s.get(3) == Some(&0) && s.iter().any(|&b| b != 0) {
                     return Err(Error::Invalid("shape table"));
                 }
+                // Both extents known, or neither.
+                if let Some(&[m, t]) = s.get(SHAPE_EXTENT_AT..SHAPE_EXTENT_AT + 2) {
+                    if (m == 0) != (t == 0) {
+                        return Err(Error::Invalid("shape table"));
+                    }
+                }
             }
-            if stride == SHAPE_BYTES {
+            if stride >= SHAPE_BYTES_V5 {
                 shapes = at as u16;
             }
             at += stride * n;
@@ -303,6 +323,7 @@ impl<'a> Library<'a> {
             n,
             offsets,
             shapes,
+            stride: stride as u8,
         })
     }
 
@@ -312,8 +333,8 @@ impl<'a> Library<'a> {
         if self.shapes == 0 || i >= self.n {
             return None;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i;
-        match *self.bytes.get(at..at + SHAPE_BYTES)? {
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i;
+        match *self.bytes.get(at..at + SHAPE_BYTES_V5)? {
             [l, u, f, 1..=255, t, s, h, ..] => Some([
                 f32::from(l) / 255.0,
                 f32::from(u) / 255.0,
@@ -334,13 +355,29 @@ impl<'a> Library<'a> {
         if self.shapes == 0 || i >= self.n {
             return out;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_TOLERANCE_AT;
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_TOLERANCE_AT;
         if let Some(bytes) = self.bytes.get(at..at + SHAPE_DIMS) {
             for (t, &b) in out.iter_mut().zip(bytes) {
                 *t = f32::from(b) / 255.0;
             }
         }
         out
+    }
+
+    /// How far the least of action `i`'s examples went ([`crate::extent`]); None when not
+    /// learnt (a version 5 library, or an action learnt without examples).
+    pub fn extent(&self, i: usize) -> Option<Extent> {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES {
+            return None;
+        }
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_EXTENT_AT;
+        match *self.bytes.get(at..at + 2)? {
+            [m, t] => Some(Extent {
+                moved_m: from_byte(m, MOVED_CODE_UNIT_M)?,
+                turned_rad: from_byte(t, TURNED_CODE_UNIT_RAD)?,
+            }),
+            _ => None,
+        }
     }
 
     /// Number of actions.
@@ -521,9 +558,28 @@ pub(crate) mod tests {
                 Some([l, u, f, t, st, h]) => {
                     out.extend([*l, *u, *f, 1, *t, *st, *h]);
                     out.extend([0; SHAPE_DIMS]);
+                    out.extend([0; 2]);
                 }
                 None => out.extend([0; SHAPE_BYTES]),
             }
+        }
+        out
+    }
+
+    /// `blob` (version 1) as the current version in which every action has a shape no match is
+    /// charged for (tolerance 1 in every dimension) and its examples' least extents
+    /// `(m, rad)` ([`crate::extent`]).
+    pub fn with_extents(blob: &[u8], extents: &[(f32, f32)]) -> Vec<u8> {
+        use crate::extent::{to_byte, MOVED_CODE_UNIT_M, TURNED_CODE_UNIT_RAD};
+        let mut out = blob.to_vec();
+        out[3] = LIBRARY_VERSION;
+        for &(m, t) in extents {
+            out.extend([0, 0, 0, 1, 0, 0, 128]);
+            out.extend([255; SHAPE_DIMS]);
+            out.extend([
+                to_byte(m, MOVED_CODE_UNIT_M),
+                to_byte(t, TURNED_CODE_UNIT_RAD),
+            ]);
         }
         out
     }
@@ -533,8 +589,8 @@ pub(crate) mod tests {
         let v1 = seq_library(&[(&["u", "d"], 0), (&["f", "b"], 0)]);
         let old = Library::from_bytes(&v1).unwrap();
         assert_eq!((old.len(), old.shape(0)), (2, None));
-        let v5 = with_shapes(&v1, &[Some([0, 255, 51, 51, 255, 153]), None]);
-        let lib = Library::from_bytes(&v5).unwrap();
+        let cur = with_shapes(&v1, &[Some([0, 255, 51, 51, 255, 153]), None]);
+        let lib = Library::from_bytes(&cur).unwrap();
         let near = |a: Option<Shape>, b: Shape| {
             a.is_some_and(|a| (0..6).all(|k| (a[k] - b[k]).abs() < 1e-6))
         };
@@ -546,7 +602,7 @@ pub(crate) mod tests {
         assert_eq!(lib.shape_tolerance(0), [0.0; 6]);
         assert_eq!(lib.shape_tolerance(1), [0.0; 6]);
         // The tolerances follow the shape, one byte per dimension: 51 → 0.2.
-        let mut tol = v5.clone();
+        let mut tol = cur.clone();
         let entry = tol.len() - 2 * SHAPE_BYTES;
         tol[entry + SHAPE_TOLERANCE_AT + 1] = 51;
         tol[entry + SHAPE_TOLERANCE_AT + 5] = 255;
@@ -557,13 +613,13 @@ pub(crate) mod tests {
         // A missing or partial table, a known shape without its flag, stray bytes after an
         // unknown shape.
         assert_eq!(
-            Library::from_bytes(&v5[..v5.len() - 1]).err(),
+            Library::from_bytes(&cur[..cur.len() - 1]).err(),
             Some(Error::Truncated)
         );
         let mut bad = tol.clone();
         bad[entry + 3] = 0;
         assert!(Library::from_bytes(&bad).is_err());
-        let mut bad = v5.clone();
+        let mut bad = cur.clone();
         let last = bad.len() - 2;
         bad[last] = 7;
         assert!(Library::from_bytes(&bad).is_err());
@@ -586,9 +642,36 @@ pub(crate) mod tests {
             old.push(0);
             assert!(Library::from_bytes(&old).is_err(), "version {version}");
         }
-        let mut v6 = v5.clone();
-        v6[3] = 6;
-        assert_eq!(Library::from_bytes(&v6).err(), Some(Error::Version(6)));
+        // Version 5: thirteen bytes per entry, the shape without the extents.
+        let mut v5 = v1.clone();
+        v5[3] = 5;
+        v5.extend([0, 255, 51, 1, 51, 255, 153, 0, 51, 0, 0, 0, 255]);
+        v5.extend([0; 13]);
+        let lib = Library::from_bytes(&v5).unwrap();
+        assert!(near(lib.shape(0), want));
+        assert_eq!(lib.shape_tolerance(0), [0.0, 0.2, 0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(lib.extent(0), None);
+        // The extents, both known or neither.
+        assert_eq!(lib_extent(&tol), None);
+        let mut ext = tol.clone();
+        ext[entry + 13] = 1 + 16 * 10;
+        assert!(Library::from_bytes(&ext).is_err());
+        ext[entry + 14] = 1 + 16 * 5;
+        let e = lib_extent(&ext).unwrap();
+        assert!(
+            (e.moved_m - 0.1024).abs() < 1e-5 && (e.turned_rad - 0.032).abs() < 1e-6,
+            "{e:?}"
+        );
+        let mut next = cur.clone();
+        next[3] = LIBRARY_VERSION + 1;
+        assert_eq!(
+            Library::from_bytes(&next).err(),
+            Some(Error::Version(LIBRARY_VERSION + 1))
+        );
+    }
+
+    fn lib_extent(blob: &[u8]) -> Option<crate::extent::Extent> {
+        Library::from_bytes(blob).unwrap().extent(0)
     }
 
     #[test]

@@ -33,6 +33,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
 use figurine_recognizer::automaton::{earliest_start, MatcherBank};
+use figurine_recognizer::extent::{Extent, ExtentSums};
 use figurine_recognizer::features::{Accum, Shape, ShapeSums, ANGVEL, SPEED};
 use figurine_recognizer::history::Run;
 use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
@@ -134,6 +135,29 @@ fn shape_of_runs(g: &[Run]) -> Option<Shape> {
         sums.add(&r.acc, r.token == STILL);
     }
     Some(sums.shape())
+}
+
+/// How far a gesture's runs went from where it began ([`figurine_recognizer::extent`]).
+fn extent_of_runs(g: &[Run]) -> Extent {
+    let mut sums = ExtentSums::new();
+    for r in g {
+        sums.add(&r.acc);
+    }
+    sums.extent()
+}
+
+/// The least extent among gestures that moved, dimension by dimension: how far the least of
+/// an action's examples went, what the device holds a performance to
+/// ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
+pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
+    gestures
+        .into_iter()
+        .filter(|g| !g.is_empty())
+        .map(extent_of_runs)
+        .reduce(|a, b| Extent {
+            moved_m: a.moved_m.min(b.moved_m),
+            turned_rad: a.turned_rad.min(b.turned_rad),
+        })
 }
 
 /// The motion shapes of the examples that moved ([`motion_shape`]), read once for
@@ -942,7 +966,8 @@ pub fn learn_action(
         examples,
     )?
     .with_shape(mean_shape(&shapes))
-    .with_shape_tolerance(shape_tolerance(&shapes));
+    .with_shape_tolerance(shape_tolerance(&shapes))
+    .with_extent(least_extent(read.iter().map(|e| &e.runs[..])));
     Ok(entry)
 }
 

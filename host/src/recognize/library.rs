@@ -10,6 +10,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use figurine_recognizer::extent::{to_byte, Extent, MOVED_CODE_UNIT_M, TURNED_CODE_UNIT_RAD};
 use figurine_recognizer::features::Shape;
 use figurine_recognizer::pattern::{
     LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES, SHAPE_TURN_MAX,
@@ -66,6 +67,13 @@ pub struct ActionEntry {
     /// for the tolerance of every dimension.
     #[serde(default, skip_serializing)]
     pub shape_spread: Option<f32>,
+    /// How far the least of the examples went from where it began: `[metres, radians]`, the
+    /// least farthest displacement and the least farthest rotation over the examples
+    /// (`figurine_recognizer::extent`). The device reports the action only for motion that
+    /// went a share of that in a dimension that carries it, so a resting hand's fidget is no
+    /// action; absent for a pattern written by hand or learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extent: Option<[f32; 2]>,
 }
 
 /// Human-readable compiled automaton.
@@ -151,6 +159,7 @@ impl ActionEntry {
             shape_height: None,
             shape_tolerance: None,
             shape_spread: None,
+            extent: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
@@ -185,6 +194,12 @@ impl ActionEntry {
         self
     }
 
+    /// The same entry with the examples' least extent `extent` (see [`ActionEntry::extent`]).
+    pub fn with_extent(mut self, extent: Option<Extent>) -> Self {
+        self.extent = extent.map(|e| [e.moved_m, e.turned_rad]);
+        self
+    }
+
     /// The tolerance of each shape dimension: as learnt, or a library's older single spread
     /// in every dimension, or none (0).
     pub fn tolerance(&self) -> [f32; 6] {
@@ -204,6 +219,7 @@ impl ActionEntry {
                 let tol = self
                     .tolerance()
                     .map(|x| if x.is_finite() { x } else { 0.0 });
+                let extent = self.extent.filter(|e| e.iter().all(|x| x.is_finite()));
                 [
                     q(s[0]),
                     q(s[1]),
@@ -218,6 +234,8 @@ impl ActionEntry {
                     q(tol[3]),
                     q(tol[4]),
                     q(tol[5]),
+                    extent.map_or(0, |e| to_byte(e[0], MOVED_CODE_UNIT_M)),
+                    extent.map_or(0, |e| to_byte(e[1], TURNED_CODE_UNIT_RAD)),
                 ]
             }
             _ => [0; SHAPE_BYTES],

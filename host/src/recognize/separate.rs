@@ -200,6 +200,7 @@ fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
         let mut e = e.with_shape(entry.full_shape());
         e.shape_tolerance = entry.shape_tolerance;
         e.shape_spread = entry.shape_spread;
+        e.extent = entry.extent;
         e
     })
 }

@@ -1,0 +1,264 @@
+//! Stage 6c — how far a gesture went: what tells an action from a fidget.
+//!
+//! A hand holding the figurine still fidgets: it shifts it a few millimetres, tilts it a few
+//! degrees and back. Those strokes can spell an action's tokens as well as a performance does
+//! (a yaw there and back is written as a turn is), and their shape can be the action's too.
+//! What they never do is go as far as the action's examples went. So each action learns, from
+//! its examples, how far the least of them went (an [`Extent`]), and an event is reported only
+//! when its motion phrase went at least [`ACCEPT_SHARE`] of that, in a dimension that carries
+//! the action ([`far_enough`]).
+//!
+//! | measure | what | units |
+//! |---|---|---|
+//! | [`Extent::moved_m`] | farthest world displacement from where the phrase began | m |
+//! | [`Extent::turned_rad`] | farthest rotation from where it began (\|Σ ω·dt\| about the object's axes) | rad |
+//! | carries | a dimension whose least extent, rotation weighed by [`ARM_M`], is at least [`CARRY_SHARE`] of the other's | — |
+//!
+//! The farthest point, not the path: tracker noise lengthens a path without end, but moves
+//! the figurine only as far as the noise's own size. It is read at the ends of token runs,
+//! where strokes turn back. A dimension that does not carry the action tells nothing: the
+//! few millimetres a turn's examples drifted say nothing about how far a turn goes.
+
+use crate::features::{Accum, MOVED_UNIT_M, TURNED_UNIT_RAD};
+use crate::fmath;
+use crate::history::{History, HISTORY_RUNS};
+use crate::token::ARM_M;
+
+/// Least share of its action's learnt extent an event must reach in a dimension that carries
+/// the action. The project's generator draws the doodle scale of examples and performances
+/// alike from 0.5–2; its performances went at least 0.18 of their action's least example, a
+/// resting hand's fidgets at most 0.11 (measured on three learnt libraries).
+pub const ACCEPT_SHARE: f32 = 0.15;
+/// Displacement that is far enough for any action, m, however far its examples went: a hand
+/// holding the figurine still shifts it by millimetres, never 2 cm, and a child who plays a
+/// library learnt at arm's length on a tabletop goes a fraction of its examples.
+pub const ENOUGH_MOVED_M: f32 = 0.02;
+/// Rotation that is far enough for any action, rad (about 9°): a resting hand tilts the
+/// figurine by a few degrees.
+pub const ENOUGH_TURNED_RAD: f32 = 0.15;
+/// Share of the other dimension's least extent (rotation × [`ARM_M`]) a dimension must reach
+/// to carry an action: a punch barely turns and a turn barely moves; a kick and a throw carry
+/// both.
+pub const CARRY_SHARE: f32 = 0.5;
+/// The learnt extents' byte code ([`to_byte`]): steps per doubling (4.4 % a step).
+const STEPS_PER_OCTAVE: f32 = 16.0;
+/// Unit of the learnt moved extent's byte code, m (codes 1–255 span 0.1 mm – 6.3 m).
+pub const MOVED_CODE_UNIT_M: f32 = 1.0e-4;
+/// Unit of the learnt turned extent's byte code, rad (codes 1–255 span 1 mrad – 63 rad).
+pub const TURNED_CODE_UNIT_RAD: f32 = 1.0e-3;
+
+/// How far a span of motion went from where it began.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Extent {
+    /// Farthest world displacement from the start, m.
+    pub moved_m: f32,
+    /// Farthest rotation from the start, rad.
+    pub turned_rad: f32,
+}
+
+/// Running sums over consecutive runs ([`Accum::moved`], [`Accum::turned`]) and the farthest
+/// point they reached.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ExtentSums {
+    moved: [i32; 3],
+    turned: [i32; 3],
+    far: Extent,
+}
+
+impl ExtentSums {
+    /// Nothing added: the start.
+    pub const fn new() -> Self {
+        ExtentSums {
+            moved: [0; 3],
+            turned: [0; 3],
+            far: Extent {
+                moved_m: 0.0,
+                turned_rad: 0.0,
+            },
+        }
+    }
+
+    /// Adds the run after those added.
+    pub fn add(&mut self, acc: &Accum) {
+        for k in 0..3 {
+            self.moved[k] = self.moved[k].saturating_add(i32::from(acc.moved[k]));
+            self.turned[k] = self.turned[k].saturating_add(i32::from(acc.turned[k]));
+        }
+        let norm = |v: [i32; 3]| fmath::norm3(v.map(|x| x as f32));
+        self.far.moved_m = fmath::max(self.far.moved_m, norm(self.moved) * MOVED_UNIT_M);
+        self.far.turned_rad = fmath::max(self.far.turned_rad, norm(self.turned) * TURNED_UNIT_RAD);
+    }
+
+    /// How far the runs added went.
+    pub fn extent(&self) -> Extent {
+        self.far
+    }
+}
+
+/// The extent of history runs `from..=to` (those still held).
+pub fn span_extent(hist: &History, from: u32, to: u32) -> Extent {
+    let mut sums = ExtentSums::new();
+    let mut i = from;
+    // Bounded walk: a reversed or stale range costs at most one ring's worth of steps.
+    for _ in 0..=HISTORY_RUNS {
+        if let Some(r) = hist.get(i) {
+            sums.add(&r.acc);
+        }
+        if i == to {
+            break;
+        }
+        i = i.wrapping_add(1);
+    }
+    sums.extent()
+}
+
+/// Whether motion that went `went` went far enough to be an action whose least example went
+/// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
+/// in a dimension that carries the action.
+pub fn far_enough(went: Extent, least: Extent) -> bool {
+    let moved = least.moved_m;
+    let turned = ARM_M * least.turned_rad;
+    let need_moved = fmath::min(ACCEPT_SHARE * least.moved_m, ENOUGH_MOVED_M);
+    let need_turned = fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD);
+    (moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
+        || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned)
+}
+
+/// A learnt extent `x` (in the code's `unit`) as the library's byte: 1 + 16·log2(x / unit),
+/// rounded, 1–255 (0 is "not learnt").
+pub fn to_byte(x: f32, unit: f32) -> u8 {
+    let code = 1.0 + STEPS_PER_OCTAVE * fmath::ln(x / unit) / core::f32::consts::LN_2;
+    // The cast saturates, and maps NaN to 0: clamp to the codes that mean a value.
+    (fmath::round(code) as u8).max(1)
+}
+
+/// The learnt extent (in `unit`s × unit) a library byte stands for; None for 0 (not learnt).
+pub fn from_byte(b: u8, unit: f32) -> Option<f32> {
+    (b != 0)
+        .then(|| unit * fmath::exp(f32::from(b - 1) * core::f32::consts::LN_2 / STEPS_PER_OCTAVE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::QUANTITIES;
+    use crate::intake::TICK_S;
+    use crate::token::parse_token;
+
+    /// A run of `ticks` ticks, each moving `t.0` m and turning `t.1` rad.
+    fn run(ticks: u32, t: ([f32; 3], [f32; 3])) -> Accum {
+        let mut acc = Accum::new();
+        for _ in 0..ticks {
+            acc.add(&[0.0; QUANTITIES], t.0[1]);
+            acc.travel(t.0.map(|x| x / TICK_S), t.1.map(|x| x / TICK_S));
+        }
+        acc
+    }
+
+    fn moving(v: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        (v, [0.0; 3])
+    }
+
+    #[test]
+    fn the_extent_is_the_farthest_point_not_the_path() {
+        // Out 20 cm forward, 10 cm up, back down and home: 20.6 cm the farthest, 60 cm of path.
+        let mut s = ExtentSums::new();
+        for t in [
+            [0.0, 0.0, 0.01],
+            [0.0, 0.005, 0.0],
+            [0.0, -0.005, 0.0],
+            [0.0, 0.0, -0.01],
+        ] {
+            s.add(&run(20, moving(t)));
+        }
+        let e = s.extent();
+        assert!((e.moved_m - libm::hypotf(0.2, 0.1)).abs() < 1e-4, "{e:?}");
+        assert_eq!(e.turned_rad, 0.0);
+        // A yaw of 3 rad about the up axis, in one run, and back.
+        let yaw = |w: f32| ([0.0; 3], [0.0, w, 0.0]);
+        let mut s = ExtentSums::new();
+        s.add(&run(100, yaw(0.03)));
+        s.add(&run(100, yaw(-0.03)));
+        assert!(
+            (s.extent().turned_rad - 3.0).abs() < 1e-3,
+            "{:?}",
+            s.extent()
+        );
+        // Jitter of ±0.2 mm a tick goes nowhere, however long it lasts.
+        let mut s = ExtentSums::new();
+        for k in 0..100 {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            s.add(&run(1, moving([2e-4 * sign, 0.0, 0.0])));
+        }
+        assert!(s.extent().moved_m <= 2.5e-4, "{:?}", s.extent());
+    }
+
+    #[test]
+    fn the_history_span_sums_its_runs() {
+        let mut h = History::new();
+        let f = parse_token("f").unwrap();
+        let first = h.open(f, (0, 0), run(10, moving([0.0, 0.0, 0.01])));
+        let last = h.open(f, (1, 100_000), run(10, moving([0.01, 0.0, 0.0])));
+        let e = span_extent(&h, first, last);
+        assert!((e.moved_m - libm::hypotf(0.1, 0.1)).abs() < 1e-4, "{e:?}");
+        assert!((span_extent(&h, last, last).moved_m - 0.1).abs() < 1e-4);
+    }
+
+    #[test]
+    fn only_a_dimension_that_carries_the_action_admits_it() {
+        let punch = Extent {
+            moved_m: 0.2,
+            turned_rad: 0.05,
+        };
+        let turn = Extent {
+            moved_m: 0.02,
+            turned_rad: 1.6,
+        };
+        let throw = Extent {
+            moved_m: 0.1,
+            turned_rad: 0.8,
+        };
+        let fidget = Extent {
+            moved_m: 0.008,
+            turned_rad: 0.08,
+        };
+        // A fidget moves more than a turn's examples drifted and turns more than a punch's:
+        // neither dimension carries those actions, so it is neither.
+        for least in [punch, turn, throw] {
+            assert!(!far_enough(fidget, least), "{least:?}");
+        }
+        // A small punch, a quick quarter turn, a throw that swung without reaching: all far
+        // enough.
+        let small_punch = Extent {
+            moved_m: 0.04,
+            turned_rad: 0.0,
+        };
+        assert!(far_enough(small_punch, punch));
+        let quarter = Extent {
+            moved_m: 0.0,
+            turned_rad: 0.4,
+        };
+        assert!(far_enough(quarter, turn));
+        let swing = Extent {
+            moved_m: 0.01,
+            turned_rad: 0.2,
+        };
+        assert!(far_enough(swing, throw));
+        // Examples that went nowhere admit anything.
+        assert!(far_enough(Extent::default(), Extent::default()));
+    }
+
+    #[test]
+    fn learnt_extents_round_trip_through_their_byte() {
+        for x in [1.0e-4f32, 0.003, 0.05, 0.4, 2.0, 6.0] {
+            let back = from_byte(to_byte(x, MOVED_CODE_UNIT_M), MOVED_CODE_UNIT_M).unwrap();
+            assert!((back / x - 1.0).abs() < 0.025, "{x} → {back}");
+        }
+        // Below the unit, 0, negative or NaN: the least code; far above: the greatest.
+        for x in [1e-6, 0.0, -1.0, f32::NAN] {
+            assert_eq!(to_byte(x, TURNED_CODE_UNIT_RAD), 1, "{x}");
+        }
+        assert_eq!(to_byte(1e6, TURNED_CODE_UNIT_RAD), 255);
+        assert_eq!(from_byte(0, TURNED_CODE_UNIT_RAD), None);
+    }
+}
