@@ -26,6 +26,8 @@ enum Command {
     TrainEffort(recognize::effort_train::TrainEffortArgs),
     /// Run the recognizer on a pose log and print the recognised actions.
     Simulate(recognize::simulate::SimulateArgs),
+    /// Turn a motion-capture take (BVH or DeepMimic) into a figurine pose log: a real doodle.
+    Doodle(recognize::doodle::DoodleArgs),
     /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9);
     /// `eval rest`: false alarms per hour at rest; `eval sweep`: robustness to noise, rate, scale.
     Eval(recognize::eval::EvalArgs),
@@ -63,6 +65,7 @@ fn main() -> anyhow::Result<()> {
         Command::Learn(a) => recognize::learn::run(&a)?,
         Command::TrainEffort(a) => recognize::effort_train::run(&a)?,
         Command::Simulate(a) => recognize::simulate::run(&a)?,
+        Command::Doodle(a) => recognize::doodle::run(&a)?,
         Command::Eval(a) => recognize::eval::run(&a)?,
         Command::Devices(a) => link::cli::devices(&a)?,
         Command::Upload(a) => link::cli::upload(&a)?,

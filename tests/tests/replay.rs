@@ -10,6 +10,7 @@ use figurine_host::link::cli::upload_to;
 use figurine_host::link::{replay_log, Device, ReplayOptions};
 use figurine_host::poselog::PoseLog;
 use figurine_host::recognize::eval::learn_synth_library;
+use figurine_host::recognize::real_bench::{real_takes, take_doodle};
 use figurine_host::recognize::simulate::simulate_log;
 use figurine_host::synth::knobs::{Knobs, Range};
 use figurine_host::synth::sequence::sequence;
@@ -140,6 +141,15 @@ fn device_events_match_simulation_on_synthetic_and_real_logs() {
         .expect("no synthetic sequence with a revised event");
     upload_to(&mut dev, &defaults, true).expect("upload the default library");
     check_identical(&mut dev, &defaults, &revised.log, "revised events");
+    // Real doodles: people's motion capture as figurine logs (`figurine eval real`).
+    for take in real_takes().expect("real takes") {
+        match take_doodle(&take) {
+            Ok((d, _)) => {
+                check_identical(&mut dev, &defaults, &d.log, &take.take);
+            }
+            Err(e) => eprintln!("skipping {}: {e}", take.take),
+        }
+    }
     upload_to(&mut dev, &blobs, true).expect("upload");
 
     for name in ["tum_fr1_xyz_groundtruth.txt", "euroc_v102_groundtruth.csv"] {

@@ -63,6 +63,9 @@ pub fn bench() -> Result<()> {
     ));
     figurine(&["eval", "sweep", "--plot", &sweep_png.to_string_lossy()])?;
 
+    step("recognition on real doodles (people's motion capture): figurine eval real");
+    figurine(&["eval", "real"])?;
+
     step("firmware: sizes, instructions per sample, latency, sustained rate");
     if !crate::util::have("defmt-print") {
         // The mean instructions per sample come from the firmware's defmt log.

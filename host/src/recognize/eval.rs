@@ -101,6 +101,9 @@ pub enum EvalCommand {
     /// Robustness: isolated accuracy and sequence F1 as the tracker's noise, its rate or the
     /// doodle's scale is swept.
     Sweep(SweepArgs),
+    /// Real doodles: motion-capture takes of people turned into figurine logs and labelled
+    /// by hand (`host/assets/real_takes.json`), recognised; recall and precision.
+    Real(super::real_bench::RealBenchArgs),
 }
 
 impl EvalArgs {
@@ -496,6 +499,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     match &args.command {
         Some(EvalCommand::Rest(a)) => return super::rest_bench::run(a),
         Some(EvalCommand::Sweep(a)) => return super::sweep::run(a),
+        Some(EvalCommand::Real(a)) => return super::real_bench::run(a),
         None => {}
     }
     if args.pairs == 0 {

@@ -10,7 +10,10 @@
 //! - [`eval`] (+ [`eval_pairs`]): `figurine eval`; [`rest_bench`]: `figurine eval rest` (false
 //!   alarms per hour at rest); [`sweep`]: `figurine eval sweep` (robustness to noise, rate,
 //!   scale).
+//! - [`doodle`]: `figurine doodle`, a motion-capture take as a figurine pose log;
+//!   [`real_bench`]: `figurine eval real` (recognition on labelled real doodles).
 
+pub mod doodle;
 pub mod dtw;
 pub mod effort_model;
 pub mod effort_train;
@@ -19,6 +22,7 @@ pub mod eval_pairs;
 pub mod feed;
 pub mod learn;
 pub mod library;
+pub mod real_bench;
 pub mod regex;
 pub mod report;
 pub mod rest_bench;
