@@ -41,6 +41,9 @@ enum Command {
     Live(link::live::LiveArgs),
     /// Assemble a character animation (BVH, optional .glb) from actions and the doodle.
     Animate(anim::cli::AnimateArgs),
+    /// Judge whether motion looks human: foot penetration, floating, skating, torso tilt,
+    /// knees and elbows bent backwards, root pops (any BVH or DeepMimic clip).
+    Check(anim::check::CheckArgs),
     /// Inspect motion clips (`clip stages CLIP`).
     Clip(anim::cli::ClipArgs),
     /// Style-coherent motion graphs: build, synth, eval (seed 003).
@@ -72,6 +75,7 @@ fn main() -> anyhow::Result<()> {
         Command::Replay(a) => link::cli::replay(&a)?,
         Command::Live(a) => link::live::live(&a)?,
         Command::Animate(a) => anim::cli::run_animate(&a)?,
+        Command::Check(a) => anim::check::run(&a)?,
         Command::Clip(a) => anim::cli::run_clip(&a)?,
         Command::Graph(a) => graph::cli::run(a)?,
         #[cfg(feature = "render")]

@@ -66,6 +66,11 @@ pub fn bench() -> Result<()> {
     step("recognition on real doodles (people's motion capture): figurine eval real");
     figurine(&["eval", "real"])?;
 
+    step(
+        "animation plausibility against real motion capture: figurine check --reference --defaults",
+    );
+    figurine(&["check", "--reference", "--defaults"])?;
+
     step("firmware: sizes, instructions per sample, latency, sustained rate");
     if !crate::util::have("defmt-print") {
         // The mean instructions per sample come from the firmware's defmt log.

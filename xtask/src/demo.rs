@@ -4,7 +4,8 @@
 //!    would play them (a real tracker log works the same way).
 //! 2. `figurine simulate` — the recognizer (the firmware's own code) reads it: actions, start
 //!    and end, Laban Time and Weight.
-//! 3. `figurine animate` — a full-body animation along the doodled path (BVH and glTF).
+//! 3. `figurine animate` — a full-body animation along the doodled path (BVH and glTF), and
+//!    `figurine check` — how it compares with real motion capture.
 //! 4. `figurine render` — a GIF of it, plus one still frame.
 //!
 //! Everything lands in `target/demo/`.
@@ -87,6 +88,8 @@ pub fn demo() -> Result<PathBuf> {
         .arg(&bvh)
         .arg("--glb")
         .arg(&glb))?;
+    // Would a person believe it? The plausibility report against real motion capture.
+    run(figurine(&bin).arg("check").arg(&bvh))?;
 
     step("demo 4/4: render it (figurine render, Vulkan via lavapipe when there is no GPU)");
     run(figurine(&bin)

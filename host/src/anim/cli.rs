@@ -65,11 +65,16 @@ pub const LABEL_EFFORT: f64 = 0.8;
 
 /// Reads `figurine synth` labels as action events (classes → ±[`LABEL_EFFORT`], neutral 0).
 pub fn read_label_events(path: &Path) -> anyhow::Result<Vec<ActionRecord>> {
-    use crate::synth::effort::{TimeClass, WeightClass};
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     let labels: Vec<crate::synth::sequence::Label> = serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), e.line()))?;
-    Ok(labels
+    Ok(label_events(labels))
+}
+
+/// `figurine synth` labels as action events (classes → ±[`LABEL_EFFORT`], neutral 0).
+pub fn label_events(labels: Vec<crate::synth::sequence::Label>) -> Vec<ActionRecord> {
+    use crate::synth::effort::{TimeClass, WeightClass};
+    labels
         .into_iter()
         .map(|l| ActionRecord {
             action: l.action,
@@ -87,7 +92,7 @@ pub fn read_label_events(path: &Path) -> anyhow::Result<Vec<ActionRecord>> {
             },
             distance: 0,
         })
-        .collect())
+        .collect()
 }
 
 /// `figurine clip …`: inspect motion clips.

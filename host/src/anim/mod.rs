@@ -11,7 +11,8 @@
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
 //! [`contact`] (foot contacts, two-bone IK against ground penetration) →
 //! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
-//! [`plot`] draws contact sheets to look at the result.
+//! [`plot`] draws contact sheets to look at the result; [`check`] (`figurine check`) judges
+//! it against real motion capture (penetration, floating, skating, joints bent backwards).
 
 use std::path::PathBuf;
 
@@ -20,6 +21,7 @@ use thiserror::Error;
 use crate::motion::MotionError;
 
 pub mod assemble;
+pub mod check;
 pub mod cli;
 pub mod clip_spec;
 pub mod contact;

@@ -1,0 +1,618 @@
+//! `figurine check`: would a person believe this motion? A plausibility report on any BVH or
+//! DeepMimic clip, computed from its joints' world positions, in the measures
+//! motion-synthesis work judges generated motion by (PhysDiff, Yuan et al. 2023: penetration,
+//! floating, skating), plus knees bent backwards, torso tilt and root pops.
+//!
+//! | measure | how | unit |
+//! |---|---|---|
+//! | penetration | depth of a foot's lowest point below the ground: mean over frames, max | mm |
+//! | airborne | longest stretch with no foot within [`NEAR_GROUND_M`] of the ground | s |
+//! | skating | horizontal speed of a foot's lowest point while it is within [`CONTACT_M`] of the ground: median, share above [`SKATE_M_S`] | cm/s, % |
+//! | torso tilt | angle of hips → neck from vertical: 95th percentile, max | ° |
+//! | knee bent backwards | the thigh–shin bend about the hips' right axis (a knee folds the shin back, about their left): max | ° |
+//! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
+//!
+//! Lengths are read in metres; a file whose body is over [`crate::recognize::doodle::CENTIMETRE_HEIGHT`]
+//! units tall is read in centimetres. The ground is the plane y = 0 (the project's
+//! animations stand on it), or estimated as a low percentile of the feet's height
+//! ([`Ground::Auto`]) for takes recorded elsewhere. Landmarks come from
+//! [`crate::graph::roles`], so any rig with named hips, neck, legs and arms is read.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use glam::{Quat, Vec3};
+use serde::Serialize;
+
+use crate::graph::roles::{Role, RoleMap, RoleOverrides};
+use crate::motion::{Clip, Skeleton};
+use crate::recognize::doodle::CENTIMETRE_HEIGHT;
+
+/// Height of a foot's lowest point under which it is in ground contact, m.
+pub const CONTACT_M: f32 = 0.025;
+/// Height under which a foot is near the ground (not airborne), m.
+pub const NEAR_GROUND_M: f32 = 0.10;
+/// Contact-foot speed above which a frame skates, m/s.
+pub const SKATE_M_S: f32 = 0.10;
+/// Percentile of the feet's lowest height taken as the ground by [`Ground::Auto`].
+pub const AUTO_GROUND_PERCENTILE: f32 = 0.05;
+
+/// The envelope of real motion capture an animation must stay within (issue 29's goals; the
+/// real takes `cargo xtask setup` fetches, measured by `figurine check --ground auto`, sit
+/// within it but for acrobatics and floor work: `figurine check --reference`).
+pub mod envelope {
+    /// Deepest foot penetration, mm.
+    pub const PENETRATION_MM: f32 = 20.0;
+    /// Longest time with no foot near the ground, s: a jump's flight (DeepMimic's standing
+    /// long jump 0.38 s, its backflip 0.44 s).
+    pub const AIRBORNE_S: f32 = 0.5;
+    /// Median speed of a foot in contact, cm/s.
+    pub const SKATE_CM_S: f32 = 10.0;
+    /// A knee bent backwards, °.
+    pub const KNEE_BACKWARDS_DEG: f32 = 15.0;
+    /// Root speed, m/s: the fastest real take fetched (DeepMimic's run, 4.2 m/s).
+    pub const ROOT_SPEED_M_S: f32 = 4.2;
+}
+
+/// Where the ground is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Ground {
+    /// The plane y = this, metres.
+    At(f32),
+    /// A low percentile ([`AUTO_GROUND_PERCENTILE`]) of the feet's lowest height.
+    Auto,
+}
+
+/// The plausibility figures of one clip (see the module table).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Plausibility {
+    /// The clip's name.
+    pub name: String,
+    /// Its duration, s.
+    pub seconds: f32,
+    /// The ground used, m.
+    pub ground_m: f32,
+    /// Mean over frames of the deepest foot penetration, mm.
+    pub penetration_mean_mm: f32,
+    /// Deepest foot penetration, mm.
+    pub penetration_max_mm: f32,
+    /// Longest stretch with no foot near the ground, s.
+    pub airborne_max_s: f32,
+    /// Median horizontal speed of a foot in contact, cm/s.
+    pub skate_median_cm_s: f32,
+    /// Share of contact frames whose foot moves faster than [`SKATE_M_S`], %.
+    pub skate_share_pct: f32,
+    /// 95th percentile of the torso's tilt from vertical, °.
+    pub tilt_p95_deg: f32,
+    /// Largest torso tilt, °.
+    pub tilt_max_deg: f32,
+    /// Largest backward bend of a knee, °.
+    pub knee_backwards_max_deg: f32,
+    /// 95th percentile of the root's speed, m/s.
+    pub root_speed_p95: f32,
+    /// Largest root speed, m/s.
+    pub root_speed_max: f32,
+    /// 95th percentile of the root's acceleration, m/s².
+    pub root_accel_p95: f32,
+    /// Largest root acceleration, m/s².
+    pub root_accel_max: f32,
+}
+
+impl Plausibility {
+    /// The measures in which the clip leaves the real-mocap [`envelope`] (empty: within).
+    pub fn beyond(&self) -> Vec<&'static str> {
+        use envelope as e;
+        [
+            (self.penetration_max_mm > e::PENETRATION_MM, "penetration"),
+            (self.airborne_max_s > e::AIRBORNE_S, "hovering"),
+            (self.skate_median_cm_s > e::SKATE_CM_S, "skating"),
+            (
+                self.knee_backwards_max_deg > e::KNEE_BACKWARDS_DEG,
+                "knee backwards",
+            ),
+            (self.root_speed_max > e::ROOT_SPEED_M_S, "root speed"),
+        ]
+        .into_iter()
+        .filter_map(|(out, what)| out.then_some(what))
+        .collect()
+    }
+}
+
+/// A leg's landmarks: hip, knee, ankle, and the foot's points (the ankle and below).
+struct Leg {
+    hip: usize,
+    knee: usize,
+    ankle: usize,
+    foot: Vec<usize>,
+}
+
+fn descendants(sk: &Skeleton, j: usize) -> Vec<usize> {
+    let mut out = vec![j];
+    let mut k = 0;
+    while let Some(&n) = out.get(k) {
+        out.extend(sk.children(n));
+        k += 1;
+    }
+    out
+}
+
+/// The `q`-quantile of `xs` (0 for none).
+fn quantile(xs: &[f32], q: f32) -> f32 {
+    let mut v: Vec<f32> = xs.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f32::total_cmp);
+    let i = ((v.len() - 1) as f32 * q).round() as usize;
+    v[i.min(v.len() - 1)]
+}
+
+fn max_of(xs: impl IntoIterator<Item = f32>) -> f32 {
+    xs.into_iter().filter(|x| x.is_finite()).fold(0.0, f32::max)
+}
+
+/// The angle (°) by which a limb whose proximal segment points along `u` and distal one along
+/// `d` is bent the wrong way: a knee flexes about the body's left axis `left` (the shin folds
+/// back, `u × d` points left), so a bend about the right axis is backwards. Lateral bending
+/// counts for nothing. 0 for a limb bent the right way or straight.
+fn bent_backwards(u: Vec3, d: Vec3, left: Vec3) -> f32 {
+    let (Some(u), Some(d), Some(left)) =
+        (u.try_normalize(), d.try_normalize(), left.try_normalize())
+    else {
+        return 0.0;
+    };
+    let sagittal = u.cross(d).dot(left);
+    (-sagittal).atan2(u.dot(d)).to_degrees().max(0.0)
+}
+
+/// Measures `clip` (its lengths in the file's unit; `name` names it in errors).
+pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibility> {
+    if clip.len() < 3 {
+        anyhow::bail!("{name}: too short to judge ({} frames)", clip.len());
+    }
+    let sk = &clip.skeleton;
+    let roles = RoleMap::detect(sk, &RoleOverrides::new(), name)
+        .with_context(|| format!("{name}: could not find the body's landmarks"))?;
+    let world: Vec<Vec<(Vec3, Quat)>> = clip
+        .frames
+        .iter()
+        .map(|p| {
+            sk.forward(p)
+                .into_iter()
+                .map(|w| (w.position, w.rotation))
+                .collect()
+        })
+        .collect();
+    let pos = |f: usize, j: usize| world[f].get(j).map_or(Vec3::ZERO, |w| w.0);
+    let j = |r: Role| roles.joint(r);
+    // Metres per unit, from the body's height in the first frame.
+    let height = pos(0, j(Role::Head)).y
+        - pos(0, j(Role::LeftFoot))
+            .y
+            .min(pos(0, j(Role::RightFoot)).y);
+    let unit = if height > CENTIMETRE_HEIGHT {
+        0.01
+    } else {
+        1.0
+    };
+    let p = |f: usize, j: usize| pos(f, j) * unit;
+    let legs: Vec<Leg> = [
+        (Role::LeftHip, Role::LeftKnee, Role::LeftFoot),
+        (Role::RightHip, Role::RightKnee, Role::RightFoot),
+    ]
+    .into_iter()
+    .map(|(h, k, a)| {
+        let foot = descendants(sk, j(a));
+        Leg {
+            hip: j(h),
+            knee: j(k),
+            ankle: j(a),
+            foot,
+        }
+    })
+    .collect();
+    let n = clip.len();
+    let dt = clip.frame_time;
+    // Each foot's lowest point per frame: (height, joint).
+    let lowest = |f: usize, leg: &Leg| {
+        leg.foot
+            .iter()
+            .map(|&i| (p(f, i).y, i))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap_or((p(f, leg.ankle).y, leg.ankle))
+    };
+    let ground_m = match ground {
+        Ground::At(y) => y,
+        Ground::Auto => {
+            let lows: Vec<f32> = (0..n)
+                .flat_map(|f| legs.iter().map(move |l| (f, l)))
+                .map(|(f, l)| lowest(f, l).0)
+                .collect();
+            quantile(&lows, AUTO_GROUND_PERCENTILE)
+        }
+    };
+    let mut penetration = Vec::with_capacity(n);
+    let mut airborne_run = 0usize;
+    let mut airborne_max = 0usize;
+    let mut contact_speeds = Vec::new();
+    for f in 0..n {
+        let lows: Vec<(f32, usize)> = legs.iter().map(|l| lowest(f, l)).collect();
+        let deepest = lows.iter().map(|l| l.0).fold(f32::INFINITY, f32::min);
+        penetration.push((ground_m - deepest).max(0.0) * 1000.0);
+        if deepest - ground_m > NEAR_GROUND_M {
+            airborne_run += 1;
+            airborne_max = airborne_max.max(airborne_run);
+        } else {
+            airborne_run = 0;
+        }
+        if f + 1 < n {
+            for &(h, i) in &lows {
+                if h - ground_m <= CONTACT_M {
+                    let d = p(f + 1, i) - p(f, i);
+                    contact_speeds.push(Vec3::new(d.x, 0.0, d.z).length() / dt);
+                }
+            }
+        }
+    }
+    let skating = contact_speeds.iter().filter(|&&s| s > SKATE_M_S).count();
+    let tilt: Vec<f32> = (0..n)
+        .map(|f| {
+            let up = p(f, j(Role::Neck)) - p(f, j(Role::Hips));
+            up.try_normalize()
+                .map_or(0.0, |u| u.dot(Vec3::Y).clamp(-1.0, 1.0).acos().to_degrees())
+        })
+        .collect();
+    let knee_back = max_of((0..n).flat_map(|f| {
+        let left = p(f, j(Role::LeftHip)) - p(f, j(Role::RightHip));
+        legs.iter()
+            .map(|l| {
+                let (hip, knee, ankle) = (p(f, l.hip), p(f, l.knee), p(f, l.ankle));
+                bent_backwards(knee - hip, ankle - knee, left)
+            })
+            .collect::<Vec<_>>()
+    }));
+    let root: Vec<Vec3> = (0..n).map(|f| p(f, j(Role::Hips))).collect();
+    let speed: Vec<f32> = root
+        .windows(2)
+        .map(|w| (w[1] - w[0]).length() / dt)
+        .collect();
+    let accel: Vec<f32> = root
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).length() / (dt * dt))
+        .collect();
+    Ok(Plausibility {
+        name: name.to_string(),
+        seconds: clip.duration(),
+        ground_m,
+        penetration_mean_mm: penetration.iter().sum::<f32>() / n as f32,
+        penetration_max_mm: max_of(penetration.iter().copied()),
+        airborne_max_s: airborne_max as f32 * dt,
+        skate_median_cm_s: quantile(&contact_speeds, 0.5) * 100.0,
+        skate_share_pct: if contact_speeds.is_empty() {
+            0.0
+        } else {
+            100.0 * skating as f32 / contact_speeds.len() as f32
+        },
+        tilt_p95_deg: quantile(&tilt, 0.95),
+        tilt_max_deg: max_of(tilt.iter().copied()),
+        knee_backwards_max_deg: knee_back,
+        root_speed_p95: quantile(&speed, 0.95),
+        root_speed_max: max_of(speed.iter().copied()),
+        root_accel_p95: quantile(&accel, 0.95),
+        root_accel_max: max_of(accel.iter().copied()),
+    })
+}
+
+/// `figurine check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Clips to judge: BVH files, or DeepMimic clips (`humanoid3d_*.txt`).
+    #[arg(required_unless_present_any = ["defaults", "reference"])]
+    pub clips: Vec<PathBuf>,
+    /// Judge every default action in the four effort corners and neutral, assembled along a
+    /// generated doodle (as `figurine animate` would), against the real-mocap envelope.
+    #[arg(long)]
+    pub defaults: bool,
+    /// Judge the real motion capture `cargo xtask setup` fetched (the reference; ground
+    /// estimated).
+    #[arg(long)]
+    pub reference: bool,
+    /// Seed of the doodles `--defaults` generates.
+    #[arg(long, default_value_t = 5)]
+    pub seed: u64,
+    /// The ground: a height in metres, or `auto` (a low percentile of the feet's height).
+    #[arg(long, default_value = "0")]
+    pub ground: String,
+    /// Print one JSON object per clip instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Every default action in the four effort corners and neutral, each assembled along a
+/// doodle generated at `seed` from its label (as `figurine animate --labels` does), judged.
+pub fn check_defaults(seed: u64) -> Result<Vec<Plausibility>> {
+    use super::assemble::{assemble_guided, AssembleOptions};
+    use crate::synth::{gesture, Action, Effort, Knobs, TimeClass, WeightClass};
+    let library = super::library::ClipLibrary::default_library()?;
+    let efforts = [
+        (
+            "sudden-strong",
+            Effort::new(TimeClass::Sudden, WeightClass::Strong),
+        ),
+        (
+            "sudden-light",
+            Effort::new(TimeClass::Sudden, WeightClass::Light),
+        ),
+        (
+            "sustained-strong",
+            Effort::new(TimeClass::Sustained, WeightClass::Strong),
+        ),
+        (
+            "sustained-light",
+            Effort::new(TimeClass::Sustained, WeightClass::Light),
+        ),
+        ("neutral", Effort::NEUTRAL),
+    ];
+    let mut rows = Vec::new();
+    for action in Action::ALL {
+        for (name, effort) in efforts {
+            let d = gesture(seed, &Knobs::default(), action, effort);
+            let events = super::cli::label_events(d.labels.clone());
+            let clips = library.load(events.iter().map(|e| e.action.as_str()))?;
+            let asm = assemble_guided(
+                &events,
+                Some(&d.log),
+                &clips,
+                library.forward(),
+                &AssembleOptions::default(),
+                None,
+            )?;
+            let label = format!("{} {name}", action.name());
+            rows.push(check_clip(&asm.clip, Ground::At(0.0), &label)?);
+        }
+    }
+    Ok(rows)
+}
+
+/// The real takes of the data folder (BVH files, DeepMimic clips), judged with the ground
+/// estimated.
+pub fn check_reference() -> Result<Vec<Plausibility>> {
+    let dir = crate::data::data_dir();
+    let mut files: Vec<PathBuf> = ["bvh", "deepmimic"]
+        .iter()
+        .filter_map(|sub| std::fs::read_dir(dir.join(sub)).ok())
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_default();
+            name.ends_with(".bvh") || (name.starts_with("humanoid3d_") && name.ends_with(".txt"))
+        })
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        anyhow::bail!(
+            "no motion capture under {}: run `cargo xtask setup` to fetch it",
+            dir.display()
+        );
+    }
+    files.iter().map(|p| check_path(p, Ground::Auto)).collect()
+}
+
+/// Loads and judges one clip file.
+pub fn check_path(path: &std::path::Path, ground: Ground) -> Result<Plausibility> {
+    let (clip, _) = super::cli::load_named_clip(&path.to_string_lossy(), None, None)?;
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    check_clip(&clip, ground, &name)
+}
+
+/// Runs `figurine check`.
+pub fn run(a: &CheckArgs) -> Result<()> {
+    let ground = match a.ground.as_str() {
+        "auto" => Ground::Auto,
+        y => Ground::At(
+            y.parse::<f32>()
+                .ok()
+                .filter(|y| y.is_finite())
+                .with_context(|| format!("--ground {y}: a height in metres, or auto"))?,
+        ),
+    };
+    let mut rows = Vec::new();
+    if a.reference {
+        rows.extend(check_reference()?);
+    }
+    if a.defaults {
+        rows.extend(check_defaults(a.seed)?);
+    }
+    for path in &a.clips {
+        rows.push(check_path(path, ground)?);
+    }
+    if a.json {
+        for r in &rows {
+            println!("{}", serde_json::to_string(r)?);
+        }
+        return Ok(());
+    }
+    print_table(&rows);
+    let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
+    println!(
+        "within the real-mocap envelope (penetration ≤ {} mm, airborne ≤ {} s, contact-foot \
+         speed ≤ {} cm/s, knees backwards ≤ {}°, root ≤ {} m/s): {within} of {}",
+        envelope::PENETRATION_MM,
+        envelope::AIRBORNE_S,
+        envelope::SKATE_CM_S,
+        envelope::KNEE_BACKWARDS_DEG,
+        envelope::ROOT_SPEED_M_S,
+        rows.len()
+    );
+    let mut counts: std::collections::BTreeMap<&str, usize> = Default::default();
+    for r in &rows {
+        for b in r.beyond() {
+            *counts.entry(b).or_default() += 1;
+        }
+    }
+    if !counts.is_empty() {
+        let list: Vec<String> = counts.iter().map(|(k, n)| format!("{k} {n}")).collect();
+        println!("beyond it: {}", list.join(", "));
+    }
+    Ok(())
+}
+
+/// Prints the figures of `rows` as a table, one clip a line.
+pub fn print_table(rows: &[Plausibility]) {
+    println!(
+        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>11} {:>13}",
+        "clip",
+        "s",
+        "penetr. mm",
+        "air s",
+        "skate cm/s %",
+        "tilt p95/max",
+        "knee°",
+        "root m/s",
+        "root m/s²"
+    );
+    // (The measures beyond the envelope follow each row.)
+    for r in rows {
+        println!(
+            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0}",
+            r.name.chars().take(28).collect::<String>(),
+            r.seconds,
+            r.penetration_mean_mm,
+            r.penetration_max_mm,
+            r.airborne_max_s,
+            r.skate_median_cm_s,
+            r.skate_share_pct,
+            r.tilt_p95_deg,
+            r.tilt_max_deg,
+            r.knee_backwards_max_deg,
+            r.root_speed_p95,
+            r.root_speed_max,
+            r.root_accel_p95,
+            r.root_accel_max,
+        );
+        let beyond = r.beyond();
+        if !beyond.is_empty() {
+            println!("{:<28} beyond: {}", "", beyond.join(", "));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::{Joint, Pose};
+
+    /// A stick figure facing +Z (left towards +X), 1.7 m tall, standing with its soles on the
+    /// ground: `pose(f, &mut Pose)` animates frame `f` of `frames` at 30 fps.
+    fn figure(frames: usize, pose: impl Fn(usize, &mut Pose)) -> Clip {
+        let j = |name: &str, parent: Option<usize>, o: [f32; 3]| {
+            Joint::bare(name, parent, Vec3::from(o))
+        };
+        let skeleton = Skeleton {
+            joints: vec![
+                j("Hips", None, [0.0, 0.9, 0.0]),
+                j("LeftUpLeg", Some(0), [0.1, 0.0, 0.0]),
+                j("LeftLeg", Some(1), [0.0, -0.42, 0.0]),
+                j("LeftFoot", Some(2), [0.0, -0.42, 0.0]),
+                j("LeftToe", Some(3), [0.0, -0.06, 0.15]),
+                j("RightUpLeg", Some(0), [-0.1, 0.0, 0.0]),
+                j("RightLeg", Some(5), [0.0, -0.42, 0.0]),
+                j("RightFoot", Some(6), [0.0, -0.42, 0.0]),
+                j("RightToe", Some(7), [0.0, -0.06, 0.15]),
+                j("Spine", Some(0), [0.0, 0.2, 0.0]),
+                j("Neck", Some(9), [0.0, 0.35, 0.0]),
+                j("Head", Some(10), [0.0, 0.2, 0.0]),
+                j("LeftArm", Some(9), [0.18, 0.3, 0.0]),
+                j("LeftForeArm", Some(12), [0.0, -0.28, 0.0]),
+                j("LeftHand", Some(13), [0.0, -0.25, 0.0]),
+                j("RightArm", Some(9), [-0.18, 0.3, 0.0]),
+                j("RightForeArm", Some(15), [0.0, -0.28, 0.0]),
+                j("RightHand", Some(16), [0.0, -0.25, 0.0]),
+            ],
+        };
+        let frames = (0..frames)
+            .map(|f| {
+                let mut p = Pose::rest(&skeleton);
+                pose(f, &mut p);
+                p
+            })
+            .collect();
+        Clip {
+            name: "figure".into(),
+            skeleton,
+            frame_time: 1.0 / 30.0,
+            frames,
+        }
+    }
+
+    fn check(clip: &Clip) -> Plausibility {
+        check_clip(clip, Ground::At(0.0), "figure").unwrap()
+    }
+
+    #[test]
+    fn standing_still_is_plausible_in_every_measure() {
+        let r = check(&figure(30, |_, _| {}));
+        assert_eq!(r.penetration_max_mm, 0.0);
+        assert_eq!(r.airborne_max_s, 0.0);
+        assert_eq!(r.skate_median_cm_s, 0.0);
+        assert_eq!(r.tilt_max_deg, 0.0);
+        assert_eq!(r.knee_backwards_max_deg, 0.0);
+        assert_eq!(r.root_speed_max, 0.0);
+    }
+
+    #[test]
+    fn a_knee_bent_backwards_is_measured_and_one_bent_forwards_is_not() {
+        // The left shin rotated about the left axis (+X): a positive angle swings the foot
+        // forward of the knee, which only a knee bent backwards does.
+        let bent = |deg: f32| {
+            check(&figure(3, move |_, p| {
+                p.rotations[2] = Quat::from_rotation_x(-deg.to_radians());
+            }))
+            .knee_backwards_max_deg
+        };
+        assert!((bent(30.0) - 30.0).abs() < 0.1, "{}", bent(30.0));
+        assert_eq!(bent(-60.0), 0.0, "a knee flexed the right way");
+    }
+
+    #[test]
+    fn hovering_sinking_skating_and_leaning_are_measured() {
+        // Lifted 0.5 m for the second of two seconds.
+        let r = check(&figure(60, |f, p| {
+            if f >= 30 {
+                p.translations[0].y += 0.5;
+            }
+        }));
+        assert!((r.airborne_max_s - 30.0 / 30.0).abs() < 0.05, "{r:?}");
+        // 3 cm into the ground.
+        let r = check(&figure(10, |_, p| p.translations[0].y -= 0.03));
+        assert!((r.penetration_max_mm - 30.0).abs() < 0.5, "{r:?}");
+        assert!((r.penetration_mean_mm - 30.0).abs() < 0.5, "{r:?}");
+        // Gliding at 0.6 m/s with both feet on the ground.
+        let r = check(&figure(30, |f, p| p.translations[0].z += 0.02 * f as f32));
+        assert!((r.skate_median_cm_s - 60.0).abs() < 0.5, "{r:?}");
+        assert_eq!(r.skate_share_pct, 100.0);
+        assert!((r.root_speed_max - 0.6).abs() < 1e-3, "{r:?}");
+        // The whole body pitched forward 45° about the hips.
+        let r = check(&figure(5, |_, p| {
+            p.rotations[0] = Quat::from_rotation_x(0.25 * std::f32::consts::PI)
+        }));
+        assert!((r.tilt_max_deg - 45.0).abs() < 0.1, "{r:?}");
+    }
+
+    #[test]
+    fn a_take_in_centimetres_reads_alike() {
+        let metres = figure(30, |f, p| p.translations[0].z += 0.02 * f as f32);
+        let mut cm = metres.clone();
+        cm.scale_lengths(100.0);
+        let (a, b) = (check(&metres), check(&cm));
+        assert!((a.skate_median_cm_s - b.skate_median_cm_s).abs() < 0.01);
+        assert!(check_clip(&figure(2, |_, _| {}), Ground::Auto, "short").is_err());
+    }
+}
