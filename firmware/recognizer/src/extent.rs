@@ -21,7 +21,7 @@
 
 use crate::features::{Accum, MOVED_UNIT_M, TURNED_UNIT_RAD};
 use crate::fmath;
-use crate::history::{History, HISTORY_RUNS};
+use crate::history::History;
 use crate::token::ARM_M;
 
 /// Least share of its action's learnt extent an event must reach in a dimension that carries
@@ -99,16 +99,8 @@ impl ExtentSums {
 /// The extent of history runs `from..=to` (those still held).
 pub fn span_extent(hist: &History, from: u32, to: u32) -> Extent {
     let mut sums = ExtentSums::new();
-    let mut i = from;
-    // Bounded walk: a reversed or stale range costs at most one ring's worth of steps.
-    for _ in 0..=HISTORY_RUNS {
-        if let Some(r) = hist.get(i) {
-            sums.add(&r.acc);
-        }
-        if i == to {
-            break;
-        }
-        i = i.wrapping_add(1);
+    for r in hist.runs(from, to) {
+        sums.add(&r.acc);
     }
     sums.extent()
 }
@@ -145,6 +137,13 @@ mod tests {
     use crate::features::QUANTITIES;
     use crate::intake::TICK_S;
     use crate::token::parse_token;
+
+    fn ext(moved_m: f32, turned_rad: f32) -> Extent {
+        Extent {
+            moved_m,
+            turned_rad,
+        }
+    }
 
     /// A run of `ticks` ticks, each moving `t.0` m and turning `t.1` rad.
     fn run(ticks: u32, t: ([f32; 3], [f32; 3])) -> Accum {
@@ -207,22 +206,10 @@ mod tests {
 
     #[test]
     fn only_a_dimension_that_carries_the_action_admits_it() {
-        let punch = Extent {
-            moved_m: 0.2,
-            turned_rad: 0.05,
-        };
-        let turn = Extent {
-            moved_m: 0.02,
-            turned_rad: 1.6,
-        };
-        let throw = Extent {
-            moved_m: 0.1,
-            turned_rad: 0.8,
-        };
-        let fidget = Extent {
-            moved_m: 0.008,
-            turned_rad: 0.08,
-        };
+        let punch = ext(0.2, 0.05);
+        let turn = ext(0.02, 1.6);
+        let throw = ext(0.1, 0.8);
+        let fidget = ext(0.008, 0.08);
         // A fidget moves more than a turn's examples drifted and turns more than a punch's:
         // neither dimension carries those actions, so it is neither.
         for least in [punch, turn, throw] {
@@ -230,20 +217,11 @@ mod tests {
         }
         // A small punch, a quick quarter turn, a throw that swung without reaching: all far
         // enough.
-        let small_punch = Extent {
-            moved_m: 0.04,
-            turned_rad: 0.0,
-        };
+        let small_punch = ext(0.04, 0.0);
         assert!(far_enough(small_punch, punch));
-        let quarter = Extent {
-            moved_m: 0.0,
-            turned_rad: 0.4,
-        };
+        let quarter = ext(0.0, 0.4);
         assert!(far_enough(quarter, turn));
-        let swing = Extent {
-            moved_m: 0.01,
-            turned_rad: 0.2,
-        };
+        let swing = ext(0.01, 0.2);
         assert!(far_enough(swing, throw));
         // Examples that went nowhere admit anything.
         assert!(far_enough(Extent::default(), Extent::default()));

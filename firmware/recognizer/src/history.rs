@@ -111,19 +111,29 @@ impl History {
         self.runs.get_mut(idx as usize % HISTORY_RUNS)
     }
 
+    /// The runs `from..=to` that are still held, oldest first. The walk is bounded: a
+    /// reversed or stale range costs at most one ring's worth of steps.
+    pub fn runs(&self, from: u32, to: u32) -> impl Iterator<Item = &Run> + '_ {
+        let mut i = from;
+        let mut done = false;
+        (0..=HISTORY_RUNS)
+            .map_while(move |_| {
+                if done {
+                    return None;
+                }
+                let run = self.get(i);
+                done = i == to;
+                i = i.wrapping_add(1);
+                Some(run)
+            })
+            .flatten()
+    }
+
     /// Sum of the feature accumulators of runs `from..=to` (those still held).
     pub fn accum(&self, from: u32, to: u32) -> Accum {
         let mut acc = Accum::new();
-        let mut i = from;
-        // Bounded walk: a reversed or stale range costs at most one ring's worth of steps.
-        for _ in 0..=HISTORY_RUNS {
-            if let Some(r) = self.get(i) {
-                acc.merge(&r.acc);
-            }
-            if i == to {
-                break;
-            }
-            i = i.wrapping_add(1);
+        for r in self.runs(from, to) {
+            acc.merge(&r.acc);
         }
         acc
     }

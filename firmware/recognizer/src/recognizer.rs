@@ -1113,12 +1113,21 @@ mod tests {
     /// A twist about the vertical axis by `angle` rad in 0.12 s, after 0.6 s of stillness and
     /// before 0.8 s more, at 200 Hz.
     fn quick_twist(angle: f32) -> Vec<Sample> {
+        twists(angle, 0.12, None)
+    }
+
+    /// A twist about the vertical axis by `angle` rad in `twist` s after 0.6 s of stillness,
+    /// and, `back` s later if given, the same twist back; then 0.8 s of stillness; 200 Hz.
+    fn twists(angle: f32, twist: f32, back: Option<f32>) -> Vec<Sample> {
         let rate = 200.0f32;
-        let (lead, twist) = (0.6f32, 0.12f32);
-        (0..((lead + twist + 0.8) * rate) as u32)
+        let lead = 0.6f32;
+        let moving = back.map_or(twist, |hold| 2.0 * twist + hold);
+        (0..((lead + moving + 0.8) * rate) as u32)
             .map(|i| {
                 let t = i as f32 / rate;
-                let half = 0.5 * angle * ramp((t - lead) / twist);
+                let there = ramp((t - lead) / twist);
+                let back = back.map_or(0.0, |hold| ramp((t - lead - twist - hold) / twist));
+                let half = 0.5 * angle * (there - back);
                 Sample {
                     seq: i,
                     t_us: (t * 1e6) as u64,
@@ -1141,27 +1150,6 @@ mod tests {
         assert!(ev[0].end_us - ev[0].start_us < MIN_ACTION_US, "{ev:?}");
     }
 
-    /// A twist about the vertical axis by `angle` rad in 60 ms and back 0.3 s later, after
-    /// 0.6 s of stillness and before 0.8 s more, at 200 Hz.
-    fn twist_and_back(angle: f32) -> Vec<Sample> {
-        let rate = 200.0f32;
-        let (lead, twist, hold) = (0.6f32, 0.06f32, 0.3f32);
-        (0..((lead + 2.0 * twist + hold + 0.8) * rate) as u32)
-            .map(|i| {
-                let t = i as f32 / rate;
-                let there = ramp((t - lead) / twist);
-                let back = ramp((t - lead - twist - hold) / twist);
-                let half = 0.5 * angle * (there - back);
-                Sample {
-                    seq: i,
-                    t_us: (t * 1e6) as u64,
-                    pos: [0.3, 1.0, 0.0],
-                    quat: [libm::cosf(half), 0.0, libm::sinf(half), 0.0],
-                }
-            })
-            .collect()
-    }
-
     #[test]
     fn a_fidget_that_spells_an_action_is_no_action() {
         // A yaw there and back, learnt from examples that turned at least 1.6 rad (and moved
@@ -1172,11 +1160,11 @@ mod tests {
         let lib = Library::from_bytes(&learnt).unwrap();
         // 5° there and back spells it: with no extents learnt (a version 1 library) it is
         // reported; with them it went nowhere near as far as a turn goes.
-        let fidget = twist_and_back(0.09);
+        let fidget = twists(0.09, 0.06, Some(0.3));
         assert_eq!(run(&unknown, &fidget).len(), 1, "the tokens spell it");
         assert_eq!(run(&lib, &fidget), []);
         // 30° there and back: a turn played small, but played.
-        let ev = run(&lib, &twist_and_back(0.5));
+        let ev = run(&lib, &twists(0.5, 0.06, Some(0.3)));
         assert_eq!(ev.len(), 1, "{ev:?}");
     }
 
