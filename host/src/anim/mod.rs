@@ -5,7 +5,8 @@
 //! [`library`] (action → clip variants; an entry's format in [`clip_spec`]) →
 //! [`variants`] (the variant matching the recognised effort) →
 //! [`phrasing`] (stages of each clip, §6.1) →
-//! [`effort`] (retime eq. 6, rescale eq. 7, weight arc length, reshape; §6.3–6.4) →
+//! [`effort`] (retime eq. 6, rescale eq. 7 within the hinges' range ([`joint_limits`]), weight
+//! arc length, reshape; §6.3–6.4) →
 //! [`trajectory`] (doodle → ground path, in-place offsets, cycles, jumps; §6.2) →
 //! [`looping`] (seamless repeats of looping clips) →
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
@@ -27,6 +28,7 @@ pub mod clip_spec;
 pub mod contact;
 pub mod effort;
 pub mod graph_cuts;
+pub mod joint_limits;
 pub mod library;
 pub mod looping;
 pub mod phrasing;
