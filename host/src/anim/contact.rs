@@ -6,7 +6,9 @@
 //! hip–knee–ankle triple is the pair of consecutive bones with the largest shorter bone (thigh
 //! and shin are the long ones). A foot's points are its ankle and everything below it.
 //! A foot is in contact when its lowest point is within [`CONTACT_HEIGHT`] of the ground and
-//! it moves slower than [`CONTACT_SPEED`] horizontally.
+//! it moves slower than [`CONTACT_SPEED`] horizontally. After effort transfer, whose rescaling
+//! of the root's height would otherwise lift a strong action off the ground, the frames in
+//! which the source clip stood are put back on the ground ([`keep_source_contacts`]).
 
 use glam::{Quat, Vec3};
 
@@ -173,6 +175,64 @@ pub struct GroundFix {
     pub max_depth: f32,
 }
 
+/// The lowest foot point's height in each frame of `clip` (∞ without legs).
+fn lowest_feet(clip: &Clip, legs: &[Leg]) -> Vec<f32> {
+    clip.frames
+        .iter()
+        .map(|p| {
+            let world = clip.skeleton.positions(p);
+            legs.iter()
+                .flat_map(|l| l.foot.iter())
+                .filter_map(|&j| world.get(j).map(|w| w.y))
+                .fold(f32::INFINITY, f32::min)
+        })
+        .collect()
+}
+
+/// Keeps on the ground the feet that `src` had on it: `out` (the same frames after effort
+/// transfer, which rescales the root's height) is moved up or down, frame by frame, so that
+/// its lowest foot is as high as the source's was wherever the source stood (its lowest foot
+/// within [`CONTACT_HEIGHT`] of the ground); in the air the correction of the frames around is
+/// blended, so an amplified jump flies higher but takes off and lands where the source did.
+/// Returns the largest correction, metres.
+pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
+    let legs = find_legs(src);
+    if legs.is_empty() || src.len() != out.len() {
+        return 0.0;
+    }
+    let was = lowest_feet(src, &legs);
+    let now = lowest_feet(out, &legs);
+    let grounded: Vec<Option<f32>> = was
+        .iter()
+        .zip(&now)
+        .map(|(&w, &n)| (w < GROUND_Y + CONTACT_HEIGHT && (w - n).is_finite()).then_some(w - n))
+        .collect();
+    let mut largest = 0.0f32;
+    for (f, pose) in out.frames.iter_mut().enumerate() {
+        let before = grounded[..=f]
+            .iter()
+            .enumerate()
+            .rev()
+            .find_map(|(i, c)| c.map(|c| (i, c)));
+        let after = grounded[f..]
+            .iter()
+            .enumerate()
+            .find_map(|(i, c)| c.map(|c| (f + i, c)));
+        let corr = match (before, after) {
+            (Some((a, ca)), Some((b, cb))) if b > a => {
+                ca + (cb - ca) * (f - a) as f32 / (b - a) as f32
+            }
+            (Some((_, c)), _) | (None, Some((_, c))) => c,
+            (None, None) => 0.0,
+        };
+        if let Some(t) = pose.translations.first_mut() {
+            t.y += corr;
+        }
+        largest = largest.max(corr.abs());
+    }
+    largest
+}
+
 /// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
 /// cannot reach, the root is raised by what remains.
 pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
@@ -328,5 +388,50 @@ mod tests {
         assert_eq!(fix.raised_frames, 2);
         let p = c.joint_positions(1);
         assert!(p[3].y >= -1e-4 && p[4].y >= -1e-4, "{p:?}");
+    }
+
+    #[test]
+    fn feet_the_source_stood_on_stay_on_the_ground_and_a_jump_still_flies() {
+        // The source stands with its lowest foot point on the ground, jumps 0.2 m for frames
+        // 3–5, and lands; the rescaled copy hovers 0.3 m while standing and jumps 0.4 m.
+        let base = leg_clip();
+        let lowest = |c: &Clip, f: usize| {
+            let p = c.joint_positions(f);
+            p[3].y.min(p[4].y)
+        };
+        let lift = |c: &mut Clip, f: usize, dy: f32| c.frames[f].translations[0].y += dy;
+        let mut src = base.clone();
+        src.frames = vec![base.frames[0].clone(); 9];
+        let sink = lowest(&src, 0);
+        for f in 0..9 {
+            lift(&mut src, f, -sink);
+        }
+        for f in 3..6 {
+            lift(&mut src, f, 0.2);
+        }
+        let mut out = src.clone();
+        for f in 0..9 {
+            lift(&mut out, f, 0.3);
+        }
+        for f in 3..6 {
+            lift(&mut out, f, 0.2);
+        }
+        let largest = keep_source_contacts(&src, &mut out);
+        assert!((largest - 0.3).abs() < 1e-4, "{largest}");
+        for f in [0, 1, 2, 6, 7, 8] {
+            assert!(
+                lowest(&out, f).abs() < 1e-4,
+                "frame {f}: {}",
+                lowest(&out, f)
+            );
+        }
+        // In the air it flies 0.4 m, twice the source's 0.2.
+        for f in 3..6 {
+            assert!(
+                (lowest(&out, f) - 0.4).abs() < 1e-4,
+                "frame {f}: {}",
+                lowest(&out, f)
+            );
+        }
     }
 }

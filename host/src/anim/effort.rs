@@ -22,13 +22,16 @@
 //!
 //! Eq. 7 is applied with each stage's reference chained to the previous stage's rescaled end,
 //! so the rescaled motion stays continuous at stage boundaries; the hinges (knees, elbows) are
-//! then held within the range they bend in ([`super::joint_limits`]). The root's orientation (the
+//! then held within the range they bend in ([`super::joint_limits`]), and the frames in which
+//! the source stood are put back on the ground ([`super::contact::keep_source_contacts`]): a
+//! strong jump flies higher, a strong punch does not hover. The root's orientation (the
 //! body's facing and balance) is left alone; its height is rescaled, and its ground travel
 //! too for cyclic clips so that the distance per cycle follows the rescaled stride. Feet that
 //! slide because of rescaling are pinned afterwards by the assembler's contact pass.
 
 use glam::{Quat, Vec3};
 
+use super::contact::keep_source_contacts;
 use super::joint_limits::{find_hinges, limit_hinges};
 use super::phrasing::{Phrasing, Stage};
 use crate::motion::{Clip, Pose, Skeleton};
@@ -164,6 +167,8 @@ pub fn apply_effort(
     rescale_stages(clip, &mut out, &factors, scale_travel);
     // An amplified swing stays a human one: no knee or elbow bent backwards.
     limit_hinges(&find_hinges(clip), &mut out);
+    // A rescaled height flies higher where the source flew, but stands where it stood.
+    keep_source_contacts(clip, &mut out);
     reshape(&mut out, e.weight, forward);
 
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
