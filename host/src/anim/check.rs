@@ -1,7 +1,7 @@
 //! `figurine check`: would a person believe this motion? A plausibility report on any BVH or
 //! DeepMimic clip, computed from its joints' world positions, in the measures
 //! motion-synthesis work judges generated motion by (PhysDiff, Yuan et al. 2023: penetration,
-//! floating, skating), plus knees bent backwards, torso tilt and root pops.
+//! floating, skating), plus knees and elbows bent backwards, torso tilt and root pops.
 //!
 //! | measure | how | unit |
 //! |---|---|---|
@@ -10,6 +10,7 @@
 //! | skating | horizontal speed of a foot's lowest point while it is within [`CONTACT_M`] of the ground: median, share above [`SKATE_M_S`] | cm/s, % |
 //! | torso tilt | angle of hips → neck from vertical: 95th percentile, max | ° |
 //! | knee bent backwards | the thigh–shin bend about the hips' right axis (a knee folds the shin back, about their left): max | ° |
+//! | elbow bent backwards | in the upper arm's frame, the bend about the opposite of the axis the elbow folds about when well bent over the clip: max | ° |
 //! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
 //!
 //! Lengths are read in metres; a file whose body is over [`crate::recognize::doodle::CENTIMETRE_HEIGHT`]
@@ -49,7 +50,7 @@ pub mod envelope {
     pub const AIRBORNE_S: f32 = 0.5;
     /// Median speed of a foot in contact, cm/s.
     pub const SKATE_CM_S: f32 = 10.0;
-    /// A knee bent backwards, °.
+    /// A knee or an elbow bent backwards, °.
     pub const KNEE_BACKWARDS_DEG: f32 = 15.0;
     /// Root speed, m/s: the fastest real take fetched (DeepMimic's run, 4.2 m/s).
     pub const ROOT_SPEED_M_S: f32 = 4.2;
@@ -89,6 +90,8 @@ pub struct Plausibility {
     pub tilt_max_deg: f32,
     /// Largest backward bend of a knee, °.
     pub knee_backwards_max_deg: f32,
+    /// Largest backward bend of an elbow, °.
+    pub elbow_backwards_max_deg: f32,
     /// 95th percentile of the root's speed, m/s.
     pub root_speed_p95: f32,
     /// Largest root speed, m/s.
@@ -164,6 +167,28 @@ fn bent_backwards(u: Vec3, d: Vec3, left: Vec3) -> f32 {
     };
     let sagittal = u.cross(d).dot(left);
     (-sagittal).atan2(u.dot(d)).to_degrees().max(0.0)
+}
+
+/// Least bend (rad) of a frame whose bending axis tells which way an elbow folds.
+const FOLDED_RAD: f32 = 0.35;
+
+/// The largest backward bend (°) of an elbow whose upper arm and forearm point along `arm[f]`
+/// in each frame, both in the upper arm's own frame: the way the elbow folds is the axis it
+/// turns about when it is well bent, on the whole over the clip (people fold their elbows the
+/// right way far more than they overextend them), and a bend about the opposite axis is
+/// backwards. 0 for an arm never well bent.
+fn elbow_backwards(arm: &[(Vec3, Vec3)]) -> f32 {
+    let axis: Vec3 = arm
+        .iter()
+        .filter_map(|&(u, d)| {
+            let (u, d) = (u.try_normalize()?, d.try_normalize()?);
+            (u.dot(d) < FOLDED_RAD.cos()).then(|| u.cross(d).try_normalize())?
+        })
+        .sum();
+    let Some(axis) = axis.try_normalize() else {
+        return 0.0;
+    };
+    max_of(arm.iter().map(|&(u, d)| bent_backwards(u, d, axis)))
 }
 
 /// Measures `clip` (its lengths in the file's unit; `name` names it in errors).
@@ -272,6 +297,24 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
             })
             .collect::<Vec<_>>()
     }));
+    let elbow_back = [
+        (Role::LeftShoulder, Role::LeftElbow, Role::LeftHand),
+        (Role::RightShoulder, Role::RightElbow, Role::RightHand),
+    ]
+    .into_iter()
+    .map(|(s, e, h)| {
+        // In the upper arm's own frame, where an elbow's hinge axis stays put.
+        let arm: Vec<(Vec3, Vec3)> = world
+            .iter()
+            .map(|w| {
+                let at = |r: Role| w.get(j(r)).copied().unwrap_or((Vec3::ZERO, Quat::IDENTITY));
+                let local = at(s).1.inverse();
+                (local * (at(e).0 - at(s).0), local * (at(h).0 - at(e).0))
+            })
+            .collect();
+        elbow_backwards(&arm)
+    })
+    .fold(0.0, f32::max);
     let root: Vec<Vec3> = (0..n).map(|f| p(f, j(Role::Hips))).collect();
     let speed: Vec<f32> = root
         .windows(2)
@@ -297,6 +340,7 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
         tilt_p95_deg: quantile(&tilt, 0.95),
         tilt_max_deg: max_of(tilt.iter().copied()),
         knee_backwards_max_deg: knee_back,
+        elbow_backwards_max_deg: elbow_back,
         root_speed_p95: quantile(&speed, 0.95),
         root_speed_max: max_of(speed.iter().copied()),
         root_accel_p95: quantile(&accel, 0.95),
@@ -443,7 +487,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
     println!(
         "within the real-mocap envelope (penetration ≤ {} mm, airborne ≤ {} s, contact-foot \
-         speed ≤ {} cm/s, knees backwards ≤ {}°, root ≤ {} m/s): {within} of {}",
+         speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s): {within} of {}",
         envelope::PENETRATION_MM,
         envelope::AIRBORNE_S,
         envelope::SKATE_CM_S,
@@ -467,7 +511,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
 /// Prints the figures of `rows` as a table, one clip a line.
 pub fn print_table(rows: &[Plausibility]) {
     println!(
-        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>11} {:>13}",
+        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13}",
         "clip",
         "s",
         "penetr. mm",
@@ -475,13 +519,14 @@ pub fn print_table(rows: &[Plausibility]) {
         "skate cm/s %",
         "tilt p95/max",
         "knee°",
+        "elbow°",
         "root m/s",
         "root m/s²"
     );
     // (The measures beyond the envelope follow each row.)
     for r in rows {
         println!(
-            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0}",
+            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0}",
             r.name.chars().take(28).collect::<String>(),
             r.seconds,
             r.penetration_mean_mm,
@@ -492,6 +537,7 @@ pub fn print_table(rows: &[Plausibility]) {
             r.tilt_p95_deg,
             r.tilt_max_deg,
             r.knee_backwards_max_deg,
+            r.elbow_backwards_max_deg,
             r.root_speed_p95,
             r.root_speed_max,
             r.root_accel_p95,
@@ -614,5 +660,25 @@ mod tests {
         let (a, b) = (check(&metres), check(&cm));
         assert!((a.skate_median_cm_s - b.skate_median_cm_s).abs() < 0.01);
         assert!(check_clip(&figure(2, |_, _| {}), Ground::Auto, "short").is_err());
+    }
+
+    #[test]
+    fn an_elbow_folded_against_its_usual_way_is_measured() {
+        // The forearm folds about +Z (towards +X) by 30–90° in most frames, and 25° the
+        // other way in one.
+        let fold = |deg: f32| {
+            let r = deg.to_radians();
+            (Vec3::NEG_Y, Vec3::new(r.sin(), -r.cos(), 0.0))
+        };
+        let mut arm: Vec<(Vec3, Vec3)> = [30.0, 60.0, 90.0, 45.0].map(fold).to_vec();
+        assert_eq!(elbow_backwards(&arm), 0.0);
+        arm.push(fold(-25.0));
+        assert!(
+            (elbow_backwards(&arm) - 25.0).abs() < 0.01,
+            "{}",
+            elbow_backwards(&arm)
+        );
+        // An arm never well bent tells nothing.
+        assert_eq!(elbow_backwards(&[fold(5.0), fold(-10.0)]), 0.0);
     }
 }
