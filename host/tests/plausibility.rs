@@ -33,17 +33,19 @@ fn real_walking_and_dancing_takes_sit_within_the_envelope() {
 }
 
 /// Every default action in the four effort corners and neutral, as `figurine animate`
-/// assembles it: none sinks into the ground or hovers beyond a jump's flight (a strong
-/// effort's amplified height is put back on the ground wherever the source clip stood). The
-/// other measures are printed; they are not all within the envelope yet (issue 29).
+/// assembles it: none sinks into the ground, hovers beyond a jump's flight (a strong effort's
+/// amplified height is put back on the ground wherever the source clip stood) or bends an
+/// elbow backwards (the hinges are held within the source's range). The other measures are
+/// printed; they are not all within the envelope yet (issue 29).
 #[test]
-fn no_default_animation_sinks_or_hovers() {
+fn no_default_animation_sinks_hovers_or_bends_an_elbow_backwards() {
     use figurine_host::anim::check::{check_defaults, envelope};
     let rows = check_defaults(5).unwrap();
     assert_eq!(rows.len(), 60);
     for r in &rows {
         assert!(r.penetration_max_mm <= envelope::PENETRATION_MM, "{r:?}");
         assert!(r.airborne_max_s <= envelope::AIRBORNE_S, "{r:?}");
+        assert!(r.elbow_backwards_max_deg <= envelope::KNEE_BACKWARDS_DEG, "{r:?}");
     }
     let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
     eprintln!("{within} of {} within the whole envelope", rows.len());
