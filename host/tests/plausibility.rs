@@ -45,7 +45,10 @@ fn no_default_animation_sinks_hovers_or_bends_an_elbow_backwards() {
     for r in &rows {
         assert!(r.penetration_max_mm <= envelope::PENETRATION_MM, "{r:?}");
         assert!(r.airborne_max_s <= envelope::AIRBORNE_S, "{r:?}");
-        assert!(r.elbow_backwards_max_deg <= envelope::KNEE_BACKWARDS_DEG, "{r:?}");
+        assert!(
+            r.elbow_backwards_max_deg <= envelope::KNEE_BACKWARDS_DEG,
+            "{r:?}"
+        );
     }
     let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
     eprintln!("{within} of {} within the whole envelope", rows.len());
