@@ -46,7 +46,7 @@ fn no_default_animation_sinks_hovers_or_bends_an_elbow_backwards() {
         assert!(r.penetration_max_mm <= envelope::PENETRATION_MM, "{r:?}");
         assert!(r.airborne_max_s <= envelope::AIRBORNE_S, "{r:?}");
         assert!(
-            r.elbow_backwards_max_deg <= envelope::KNEE_BACKWARDS_DEG,
+            r.elbow_backwards_max_deg <= envelope::BENT_BACKWARDS_DEG,
             "{r:?}"
         );
     }
