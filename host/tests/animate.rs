@@ -515,10 +515,7 @@ fn transitions_do_not_pop() {
 
 /// Labels of `figurine synth` as events, as `figurine animate --labels` reads them.
 fn label_events(labels: &[figurine_host::synth::sequence::Label]) -> Vec<ActionRecord> {
-    let dir = out_dir();
-    let path = dir.join(format!("labels_{}.json", labels.len()));
-    std::fs::write(&path, serde_json::to_string(labels).unwrap()).unwrap();
-    figurine_host::anim::cli::read_label_events(&path).unwrap()
+    figurine_host::anim::cli::label_events(labels.to_vec())
 }
 
 #[test]

@@ -23,9 +23,7 @@ fn assembled() -> Clip {
     use figurine_host::anim::assemble::{assemble, AssembleOptions};
     use figurine_host::anim::library::ClipLibrary;
     let d = figurine_host::synth::sequence::sequence(5, &Default::default(), 4, None);
-    let labels = tmp("labels.json");
-    std::fs::write(&labels, serde_json::to_string(&d.labels).unwrap()).unwrap();
-    let events = figurine_host::anim::cli::read_label_events(&labels).unwrap();
+    let events = figurine_host::anim::cli::label_events(d.labels.clone());
     let lib = ClipLibrary::default_library().unwrap();
     let clips = lib.load(events.iter().map(|e| e.action.as_str())).unwrap();
     let mut clip = assemble(

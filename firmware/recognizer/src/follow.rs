@@ -22,7 +22,6 @@
 //! commits only, never per sample.
 
 use crate::alignment::{weighted_cost, FULL};
-use crate::extent::Extent;
 use crate::features::{Accum, SPEED};
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
@@ -55,8 +54,6 @@ pub(crate) struct Held {
     pub cost: u8,
     /// Feature sums over its motion phrase.
     pub acc: Accum,
-    /// How far its motion phrase went ([`crate::extent`]).
-    pub went: Extent,
 }
 
 /// What a match is to the held event before it.
@@ -182,7 +179,6 @@ mod tests {
             distance: cost.div_ceil(FULL),
             cost,
             acc: hist.accum(from, to),
-            went: Extent::default(),
         }
     }
 

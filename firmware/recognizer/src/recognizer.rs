@@ -5,7 +5,7 @@
 //! samples. RAM (see `capacities` in the crate docs): front end ≈ 11 KiB, automata 1.75 KiB,
 //! effort model 0.6 KiB, the last event (open to continuation, [`crate::follow`]), the state
 //! before a provisional report and the last stand-alone phrase's nearest action 0.6 KiB —
-//! 16.4 KiB in all (16,760 B by `size_of`, measured by a test) with 32 actions loaded.
+//! 16.4 KiB in all (16,744 B by `size_of`, measured by a test) with 32 actions loaded.
 
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
@@ -537,9 +537,10 @@ impl<'lib> Recognizer<'lib> {
     /// when `c` is too brief, is the held event's settling, or is a new event whose motion
     /// did not go as far as its action's examples ([`far_enough`]: a fidget).
     fn outcome(&self, c: &Candidate, held: Option<Held>) -> Option<(Held, bool, Option<Held>)> {
-        let ev = self.event_of(c)?;
+        let (ev, (from, to)) = self.event_of(c)?;
+        // Only a new event is held to its action's extent; a continuation's went before.
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
-            Some(least) if !far_enough(ev.went, least) => None,
+            Some(least) if !far_enough(span_extent(self.front.history(), from, to), least) => None,
             _ => Some((ev, false, Some(ev))),
         };
         let Some(mut h) = held else {
@@ -560,8 +561,9 @@ impl<'lib> Recognizer<'lib> {
         Some((h, true, Some(h)))
     }
 
-    /// The event `c` would be (None when its runs are gone or it is too brief to be a gesture).
-    fn event_of(&self, c: &Candidate) -> Option<Held> {
+    /// The event `c` would be, and the runs of its motion phrase (None when its runs are gone
+    /// or it is too brief to be a gesture).
+    fn event_of(&self, c: &Candidate) -> Option<(Held, (u32, u32))> {
         let hist = self.front.history();
         let start = hist.get(c.start)?.start;
         let end = hist.get(c.end)?.end;
@@ -601,8 +603,7 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         let acc = hist.accum(from, to);
-        let went = span_extent(hist, from, to);
-        Some(Held {
+        let ev = Held {
             action: c.action,
             start_run: c.start,
             start,
@@ -611,8 +612,8 @@ impl<'lib> Recognizer<'lib> {
             distance: c.distance(),
             cost: c.cost,
             acc,
-            went,
-        })
+        };
+        Some((ev, (from, to)))
     }
 
     /// Commits a candidate and emits it: as a new event, as the continuation of the held

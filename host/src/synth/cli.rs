@@ -36,7 +36,7 @@ enum SynthCommand {
         /// Effort: sudden-strong, sudden-light, sustained-strong, sustained-light, neutral, or
         /// random (one of the four states).
         #[arg(long, default_value = "random")]
-        effort: EffortArg,
+        effort: OrRandom<Effort>,
         /// Master seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -59,7 +59,7 @@ enum SynthCommand {
         count: usize,
         /// Effort of every action (default: a random state per action).
         #[arg(long, default_value = "random")]
-        effort: EffortArg,
+        effort: OrRandom<Effort>,
         /// Output pose log (CSV).
         #[arg(long)]
         out: PathBuf,
@@ -93,7 +93,7 @@ enum SynthCommand {
         count: usize,
         /// Effort of the examples (default: a random state each).
         #[arg(long, default_value = "random")]
-        effort: EffortArg,
+        effort: OrRandom<Effort>,
         /// Master seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -118,7 +118,7 @@ enum SynthCommand {
         action: Option<Action>,
         /// Effort of every performance (default: a random state each).
         #[arg(long, default_value = "random")]
-        effort: EffortArg,
+        effort: OrRandom<Effort>,
         /// Output PNG.
         #[arg(long)]
         out: PathBuf,
@@ -143,14 +143,14 @@ enum SynthCommand {
         seconds: f64,
         /// hand, table, mounted, or random.
         #[arg(long, default_value = "random")]
-        kind: KindArg,
+        kind: OrRandom<RestKind>,
         /// Tracker level: lighthouse (Lighthouse/optical mocap: 0.1-0.3 mm, 0.02-0.05 deg,
         /// 120-1000 Hz), imu-fusion (IMU + optical/UWB: 0.5-1 mm, 0.1-0.2 deg, 100-400 Hz),
         /// webcam-near (tag at 0.5 m: 0.5-1 mm across, 1-2 mm in depth, 0.2-0.3 deg, 30-60 Hz),
         /// webcam-far (tag at 1 m: 1-2 mm across, 2.5-5 mm in depth, 0.3-0.5 deg, 30 Hz), or
         /// random.
         #[arg(long, default_value = "random")]
-        tracker: TrackerArg,
+        tracker: OrRandom<TrackerLevel>,
         /// Sample rate, Hz: `V` or `LO..HI` [default: the tracker level's].
         #[arg(long, allow_hyphen_values = true)]
         rate: Option<Range>,
@@ -171,55 +171,20 @@ enum SynthCommand {
     },
 }
 
-/// `random` or a named effort.
+/// `random` (None) or a named value: an effort, a rest kind, a tracker level.
 #[derive(Debug, Clone, Copy)]
-struct EffortArg(Option<Effort>);
+struct OrRandom<T>(Option<T>);
 
-impl std::str::FromStr for EffortArg {
+impl<T: std::str::FromStr<Err = String>> std::str::FromStr for OrRandom<T> {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         if s.trim().eq_ignore_ascii_case("random") {
             Ok(Self(None))
         } else {
-            s.parse().map(|e| Self(Some(e)))
+            s.parse()
+                .map(|v| Self(Some(v)))
+                .map_err(|e| format!("{e}, or random"))
         }
-    }
-}
-
-/// `random` or a rest kind.
-#[derive(Debug, Clone, Copy)]
-struct KindArg(Option<RestKind>);
-
-impl std::str::FromStr for KindArg {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if s.trim().eq_ignore_ascii_case("random") {
-            Ok(Self(None))
-        } else {
-            s.parse().map(|k| Self(Some(k)))
-        }
-    }
-}
-
-/// `random` or a tracker level of [`TRACKER_LEVELS`](super::rest::TRACKER_LEVELS).
-#[derive(Debug, Clone, Copy)]
-struct TrackerArg(Option<TrackerLevel>);
-
-impl std::str::FromStr for TrackerArg {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if s.trim().eq_ignore_ascii_case("random") {
-            return Ok(Self(None));
-        }
-        TrackerLevel::by_name(s)
-            .map(|l| Self(Some(l)))
-            .ok_or_else(|| {
-                format!(
-                    "unknown tracker level `{}`: expected {} or random",
-                    s.trim(),
-                    TrackerLevel::names()
-                )
-            })
     }
 }
 

@@ -98,6 +98,19 @@ impl TrackerLevel {
     }
 }
 
+impl std::str::FromStr for TrackerLevel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        TrackerLevel::by_name(s).ok_or_else(|| {
+            format!(
+                "unknown tracker level `{}`: expected {}",
+                s.trim(),
+                TrackerLevel::names()
+            )
+        })
+    }
+}
+
 /// Linear interpolation inside `r` at fraction `u` ∈ [0, 1].
 fn lerp(r: Range, u: f64) -> f64 {
     r.lo + (r.hi - r.lo) * u
