@@ -14,12 +14,13 @@
 //! | 2 | a block counts as noise only if both vectors went nowhere: \|Σv\| < [`COHERENCE_MAX`] × Σ\|v\| | jitter and tremor go to and fro, a stroke or a spin goes somewhere, whatever the tracker: a gesture is not learnt as noise |
 //! | 3 | the noise is the counted block of median power among the last [`BLOCKS`] counted ones | robust to a stray counted block of a gesture; less biased than the least block where a block holds few independent samples (30 Hz) |
 //! | 4 | a vector starts moving when vᵀ C⁻¹ v ≥ 3 × [`ON_FACTOR`]² (\|v\| ≥ [`ON_FACTOR`] × rms for noise alike on all axes) and it heads somewhere (running mean velocity ≥ [`HEADING_SHARE`] × running mean speed); it stays moving down to [`OFF_FACTOR`] | two thresholds (hysteresis); a webcam's depth jitter needs more along the depth only |
+//! | 5 | failing that, the slow mean velocity (time constant [`SLOW_TAU_S`]) is judged alike against its own noise power (the mean over the counted blocks), while it is no faster than the vector is now | a sustained motion under heavy jitter stands out once averaged; a stroke that ended lingers in the mean, but the figurine no longer moves that fast |
 //!
 //! The fixed floors [`V_FLOOR_M_S`] and [`W_FLOOR_RAD_S`] stay as lower bounds; the token's
 //! minimum duration ([`crate::token::MIN_TOKEN_US`]) is the hangover. The stream's first
 //! block is spent learning (nothing moves before 0.25 s); a changed tracker (a figurine
 //! picked up from a table) is learnt within [`BLOCKS`] counted blocks (1.5 s), and a quieter
-//! one within half of that. RAM: 2 × 60 f32, about 0.5 KiB.
+//! one within half of that. RAM: 2 × 70 f32, about 0.6 KiB.
 
 use crate::fmath;
 
@@ -49,9 +50,27 @@ pub const ISOTROPIC_SHARE: f32 = 0.1;
 pub const ON_FACTOR: f32 = 2.5;
 /// A moving vector rests again below this multiple of the noise rms.
 pub const OFF_FACTOR: f32 = 1.5;
+/// Time constant (s) of the slow mean velocity, which finds motion too slow to stand out of
+/// the noise tick by tick: averaging over τ cuts the derivative's noise by about τ / the
+/// filter's window, while a steady motion keeps its speed.
+pub const SLOW_TAU_S: f32 = 0.2;
 
 /// Per-tick gain of the running means (first order: dt / τ).
 const HEADING_GAIN: f32 = crate::intake::TICK_S / HEADING_TAU_S;
+/// Per-tick gain of the slow mean velocity.
+const SLOW_GAIN: f32 = crate::intake::TICK_S / SLOW_TAU_S;
+
+/// How a vector moves this tick, judged against its noise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    /// Within the noise.
+    Still,
+    /// Louder than the noise tick by tick: its direction is the tick's own.
+    Fast,
+    /// Within the noise tick by tick, but its slow mean velocity stands out of that mean's
+    /// own noise: its direction is the slow mean's.
+    Slow,
+}
 
 /// A symmetric 3×3 matrix as (xx, yy, zz, xy, xz, yz).
 type Sym3 = [f32; 6];
@@ -118,6 +137,23 @@ struct Channel {
     mean_v: [f32; 3],
     /// Running mean speed (same).
     mean_speed: f32,
+    /// Slow mean velocity (time constant [`SLOW_TAU_S`]), in the frame the directions are read in.
+    slow: [f32; 3],
+    /// Σ|slow|² over the block.
+    slow_power: f32,
+    /// Mean |slow|² of the last counted blocks (paired with `recent`).
+    recent_slow: [f32; BLOCKS],
+    /// The slow mean's noise power (mean |slow|²) currently in force; 0 until counted.
+    slow_noise: f32,
+    /// Whether the vector is moving on the strength of its slow mean.
+    slow_moving: bool,
+}
+
+impl Motion {
+    /// Whether the vector moves at all.
+    pub fn is_moving(self) -> bool {
+        self != Motion::Still
+    }
 }
 
 impl Channel {
@@ -132,10 +168,21 @@ impl Channel {
             least,
             mean_v: [0.0; 3],
             mean_speed: 0.0,
+            slow: [0.0; 3],
+            slow_power: 0.0,
+            recent_slow: [0.0; BLOCKS],
+            slow_noise: 0.0,
+            slow_moving: false,
         }
     }
 
-    fn add(&mut self, v: [f32; 3], norm: f32) {
+    /// Adds one tick: `v` in the frame the noise is fixed in, `read` (same norm) in the frame
+    /// directions are read in.
+    fn add(&mut self, v: [f32; 3], norm: f32, read: [f32; 3]) {
+        for (m, x) in self.slow.iter_mut().zip(read) {
+            *m += SLOW_GAIN * (x - *m);
+        }
+        self.slow_power += fmath::dot3(self.slow, self.slow);
         for ((n, m), x) in self.net.iter_mut().zip(&mut self.mean_v).zip(v) {
             *n += x;
             *m += HEADING_GAIN * (x - *m);
@@ -170,6 +217,9 @@ impl Channel {
                     *r = p / f32::from(BLOCK_TICKS);
                 }
             }
+            if let Some(r) = self.recent_slow.get_mut(slot) {
+                *r = self.slow_power / f32::from(BLOCK_TICKS);
+            }
             let trace = |i: usize| {
                 self.recent
                     .get(i)
@@ -189,12 +239,24 @@ impl Channel {
                 .and_then(|&i| self.recent.get(i))
                 .copied()
                 .unwrap_or(self.noise);
+            // The slow mean holds about one independent value per block: a median of so few
+            // would sit well below its mean power, so the mean over the counted blocks is taken.
+            let counted_slow = self
+                .recent_slow
+                .iter()
+                .enumerate()
+                .filter(|&(i, _)| fmath::is_finite(trace(i)));
+            let (sum, n) = counted_slow.fold((0.0, 0.0), |(s, n), (_, &p)| (s + p, n + 1.0));
+            if n > 0.0 {
+                self.slow_noise = sum / n;
+            }
             self.noise = median;
             self.inverse = regularised_inverse(&median);
         }
         self.net = [0.0; 3];
         self.path = 0.0;
         self.power = [0.0; 6];
+        self.slow_power = 0.0;
     }
 
     /// Whether vector `v` (norm `norm`) moves: above the fixed floor, and louder than the
@@ -202,11 +264,35 @@ impl Channel {
     /// somewhere or, if already `moving`, [`OFF_FACTOR`]. For noise alike on every axis this
     /// is |v| ≥ k × rms; a tracker noisier along one direction (a webcam's depth) needs more
     /// along that direction only.
-    fn moves(&self, v: [f32; 3], norm: f32, moving: bool) -> bool {
+    ///
+    /// Failing that, the slow mean velocity is judged alike against its own noise power
+    /// (|slow|² ≥ k² × mean |slow|² at rest), as long as it is no faster than the vector is
+    /// now: a stroke that ended lingers in the slow mean for a few τ, but the figurine no
+    /// longer moves that fast.
+    fn moves(&mut self, v: [f32; 3], norm: f32, moving: bool) -> Motion {
         let k = if moving { OFF_FACTOR } else { ON_FACTOR };
-        norm >= self.least
+        if norm >= self.least
             && self.inverse.is_none_or(|m| quadratic(&m, v) >= 3.0 * k * k)
             && (moving || self.heading())
+        {
+            self.slow_moving = false;
+            return Motion::Fast;
+        }
+        let k = if self.slow_moving {
+            OFF_FACTOR
+        } else {
+            ON_FACTOR
+        };
+        let power = fmath::dot3(self.slow, self.slow);
+        self.slow_moving = self.slow_noise > 0.0
+            && power >= self.least * self.least
+            && power <= norm * norm
+            && power >= k * k * self.slow_noise;
+        if self.slow_moving {
+            Motion::Slow
+        } else {
+            Motion::Still
+        }
     }
 
     /// The noise rms (same unit as the vector).
@@ -245,10 +331,11 @@ impl NoiseFloor {
     }
 
     /// Feeds one tick: world velocity `v` (m/s; a tracker's noise is fixed in the world) with
-    /// its norm `vn`, and object-frame angular velocity `w` (rad/s) with its norm `wn`.
-    pub fn push(&mut self, v: [f32; 3], vn: f32, w: [f32; 3], wn: f32) {
-        self.lin.add(v, vn);
-        self.ang.add(w, wn);
+    /// its norm `vn` and its object-frame twin `ov`, and object-frame angular velocity `w`
+    /// (rad/s) with its norm `wn`.
+    pub fn push(&mut self, v: [f32; 3], vn: f32, ov: [f32; 3], w: [f32; 3], wn: f32) {
+        self.lin.add(v, vn, ov);
+        self.ang.add(w, wn, w);
         self.ticks += 1;
         if self.ticks >= BLOCK_TICKS {
             let counted = self.lin.went_nowhere() && self.ang.went_nowhere();
@@ -265,13 +352,26 @@ impl NoiseFloor {
     /// Whether world velocity `v` (m/s, norm `speed`) is motion, given whether the vector
     /// moved at the last tick. The stream's first block is spent learning the sensor: nothing
     /// moves before it closes.
-    pub fn translating(&self, v: [f32; 3], speed: f32, moving: bool) -> bool {
-        self.primed && self.lin.moves(v, speed, moving)
+    pub fn translating(&mut self, v: [f32; 3], speed: f32, moving: bool) -> Motion {
+        if self.primed {
+            self.lin.moves(v, speed, moving)
+        } else {
+            Motion::Still
+        }
     }
 
     /// Whether angular velocity `w` (rad/s, norm `rate`) is motion; as [`Self::translating`].
-    pub fn rotating(&self, w: [f32; 3], rate: f32, moving: bool) -> bool {
-        self.primed && self.ang.moves(w, rate, moving)
+    pub fn rotating(&mut self, w: [f32; 3], rate: f32, moving: bool) -> Motion {
+        if self.primed {
+            self.ang.moves(w, rate, moving)
+        } else {
+            Motion::Still
+        }
+    }
+
+    /// The slow mean velocity: translation in the object frame (m/s), rotation (rad/s).
+    pub fn slow(&self) -> ([f32; 3], [f32; 3]) {
+        (self.lin.slow, self.ang.slow)
     }
 
     /// The learnt noise rms of translation (m/s) and rotation (rad/s).
@@ -309,6 +409,41 @@ mod tests {
         }
     }
 
+    /// Velocity jitter as the filter makes it: white position noise differentiated by a
+    /// least-squares slope over 11 ticks, so neighbouring ticks' velocities are correlated.
+    struct Jitter {
+        noise: Noise,
+        ring: [[f32; 3]; 11],
+        at: usize,
+    }
+
+    impl Jitter {
+        fn new(seed: u64) -> Self {
+            Jitter {
+                noise: Noise(seed),
+                ring: [[0.0; 3]; 11],
+                at: 0,
+            }
+        }
+
+        /// The next tick's velocity jitter, with per-component σ `sigma` (units/s).
+        fn vec(&mut self, sigma: f32) -> [f32; 3] {
+            // Slope of a line fitted over ticks −5..5: Σ i pᵢ / Σ i², Σ i² = 110.
+            let position_sigma = sigma * TICK_S * fmath::sqrt(110.0);
+            self.ring[self.at] = self.noise.vec(position_sigma);
+            self.at = (self.at + 1) % 11;
+            let mut slope = [0.0; 3];
+            for k in 0..11 {
+                let i = k as f32 - 5.0;
+                let p = self.ring[(self.at + k) % 11];
+                for (s, x) in slope.iter_mut().zip(p) {
+                    *s += i * x / (110.0 * TICK_S);
+                }
+            }
+            slope
+        }
+    }
+
     fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
         [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
     }
@@ -327,8 +462,8 @@ mod tests {
             let t = i as f32 * TICK_S;
             let (a, b) = (v(t), w(t));
             let (an, bn) = (fmath::norm3(a), fmath::norm3(b));
-            f.push(a, an, b, bn);
-            if f.translating(a, an, false) {
+            f.push(a, an, a, b, bn);
+            if f.translating(a, an, false) != Motion::Still {
                 moved += 1;
                 run += 1;
                 longest = longest.max(run);
@@ -351,13 +486,19 @@ mod tests {
     fn nothing_moves_before_the_first_block_closes() {
         let mut f = NoiseFloor::new();
         let x = |s: f32| [s, 0.0, 0.0];
-        assert!(!f.translating(x(10.0), 10.0, true) && !f.rotating(x(10.0), 10.0, true));
+        assert!(
+            !f.translating(x(10.0), 10.0, true).is_moving()
+                && !f.rotating(x(10.0), 10.0, true).is_moving()
+        );
         feed(&mut f, 0.25, |_| [0.0; 3], |_| [0.0; 3]);
-        assert!(f.translating(x(10.0), 10.0, true) && f.rotating(x(10.0), 10.0, true));
+        assert!(
+            f.translating(x(10.0), 10.0, true).is_moving()
+                && f.rotating(x(10.0), 10.0, true).is_moving()
+        );
         // Nothing learnt from silence: the fixed floors decide.
         let (lo, hi) = (0.9 * V_FLOOR_M_S, 1.1 * V_FLOOR_M_S);
-        assert!(!f.translating(x(lo), lo, true));
-        assert!(f.translating(x(hi), hi, true));
+        assert!(!f.translating(x(lo), lo, true).is_moving());
+        assert!(f.translating(x(hi), hi, true).is_moving());
     }
 
     #[test]
@@ -368,17 +509,17 @@ mod tests {
         let mut m = Noise(4);
         feed(&mut f, 1.0, |_| n.vec(3e-7), |_| m.vec(3e-7));
         let hi = 1.1 * V_FLOOR_M_S;
-        assert!(f.translating([hi, 0.0, 0.0], hi, true));
-        assert!(f.rotating([0.0, 1.0, 0.0], 1.0, true));
+        assert!(f.translating([hi, 0.0, 0.0], hi, true).is_moving());
+        assert!(f.rotating([0.0, 1.0, 0.0], 1.0, true).is_moving());
     }
 
     #[test]
     fn white_jitter_is_learnt_and_stays_below_the_motion_threshold() {
         for (seed, sigma) in [(1u64, 0.01f32), (2, 0.05), (3, 0.15)] {
             let mut f = NoiseFloor::new();
-            let mut n = Noise(seed);
-            let mut m = Noise(seed + 100);
-            let (_, longest) = feed(&mut f, 20.0, |_| n.vec(sigma), |_| m.vec(sigma));
+            let mut n = Jitter::new(seed);
+            let mut m = Jitter::new(seed + 100);
+            let (moved, longest) = feed(&mut f, 60.0, |_| n.vec(sigma), |_| m.vec(sigma));
             let (v, w) = f.rms();
             for learnt in [v, w] {
                 assert!(
@@ -387,8 +528,12 @@ mod tests {
                     rms(sigma)
                 );
             }
-            // Jitter goes to and fro: it never heads anywhere for as long as a token lasts.
-            assert!(longest < TOKEN_TICKS, "σ {sigma}: {longest} ticks");
+            // Jitter goes to and fro: it seldom heads anywhere (under 1 % of 6,000 ticks), and
+            // never for longer than a token's least duration.
+            assert!(
+                moved < 60 && longest <= TOKEN_TICKS,
+                "σ {sigma}: {moved} ticks, {longest} in a row"
+            );
         }
     }
 
@@ -408,7 +553,7 @@ mod tests {
         );
         assert_eq!(f.rms(), before);
         assert!(moved >= 495, "{moved} of 500 ticks moved");
-        assert!(f.rotating([0.0, 6.0, 0.0], 6.0, true));
+        assert!(f.rotating([0.0, 6.0, 0.0], 6.0, true).is_moving());
     }
 
     #[test]
@@ -425,6 +570,43 @@ mod tests {
         // And back on the table, the quiet floor returns once quiet blocks are the majority.
         feed(&mut f, 1.0, |_| n.vec(0.004), |_| m.vec(0.02));
         assert!(f.rms().0 < 1.05 * rms(0.004), "{:?}", f.rms());
+    }
+
+    #[test]
+    fn a_slide_too_slow_for_any_one_tick_is_found_by_its_slow_mean() {
+        let mut f = NoiseFloor::new();
+        let mut n = Jitter::new(21);
+        let mut m = Jitter::new(22);
+        feed(&mut f, 3.0, |_| n.vec(0.05), |_| m.vec(0.1));
+        // 0.1 m/s: under half the tick-by-tick threshold (2.5 × 0.087 m/s rms).
+        let slide = [0.0, -0.1, 0.0];
+        let (moved, _) = feed(&mut f, 1.0, |_| add(slide, n.vec(0.05)), |_| m.vec(0.1));
+        assert!(moved >= 50, "{moved} of 100 ticks moved");
+        // Its direction is the slide's.
+        let (slow, _) = f.slow();
+        assert!(slow[1] < -0.07 && fmath::abs(slow[0]) < 0.03, "{slow:?}");
+        // The same jitter alone moves nothing.
+        let mut g = NoiseFloor::new();
+        let (moved, _) = feed(&mut g, 4.0, |_| n.vec(0.05), |_| m.vec(0.1));
+        assert!(moved < 4, "{moved} of 400 ticks moved");
+    }
+
+    #[test]
+    fn a_stroke_does_not_linger_after_it_ends() {
+        let mut f = NoiseFloor::new();
+        let mut n = Noise(31);
+        let mut m = Noise(32);
+        feed(&mut f, 3.0, |_| n.vec(0.01), |_| m.vec(0.05));
+        let (moved, _) = feed(
+            &mut f,
+            0.4,
+            |_| add([0.8, 0.0, 0.0], n.vec(0.01)),
+            |_| m.vec(0.05),
+        );
+        assert!(moved >= 38, "{moved}");
+        // The slow mean still holds most of the stroke, but the figurine has stopped.
+        let (after, _) = feed(&mut f, 0.5, |_| n.vec(0.01), |_| m.vec(0.05));
+        assert!(after <= 1, "{after} ticks moved after the stroke");
     }
 
     #[test]

@@ -25,7 +25,7 @@ use core::fmt;
 use crate::fmath;
 use crate::frame::Kinematics;
 use crate::intake::{TICK_S, TICK_US};
-use crate::noise::NoiseFloor;
+use crate::noise::{Motion, NoiseFloor};
 
 /// A token code: `lin × 27 + ang` for motion, [`STILL`] for stillness.
 pub type Token = u16;
@@ -387,14 +387,22 @@ impl Tokenizer {
         self.v_peak = fmath::max(vn, self.v_peak * PEAK_DECAY);
         self.w_peak = fmath::max(wn, self.w_peak * PEAK_DECAY);
         // A rotation keeps the norm: the object-frame speed is the world speed.
-        self.floor.push(k.world_v, vn, k.w, wn);
-        let v_on = self.floor.translating(k.world_v, vn, self.lin != [0; 3])
-            && vn >= REL_ACTIVE * self.v_peak
-            && vn >= ARM_M * wn;
-        let w_on =
-            self.floor.rotating(k.w, wn, self.ang != [0; 3]) && wn >= REL_ACTIVE * self.w_peak;
-        self.lin = signs(k.v, v_on, self.lin);
-        self.ang = signs(k.w, w_on, self.ang);
+        self.floor.push(k.world_v, vn, k.v, k.w, wn);
+        let (slow_v, slow_w) = self.floor.slow();
+        let (v, v_norm) = match self.floor.translating(k.world_v, vn, self.lin != [0; 3]) {
+            Motion::Still => ([0.0; 3], 0.0),
+            Motion::Fast => (k.v, vn),
+            Motion::Slow => (slow_v, fmath::norm3(slow_v)),
+        };
+        let (w, w_norm) = match self.floor.rotating(k.w, wn, self.ang != [0; 3]) {
+            Motion::Still => ([0.0; 3], 0.0),
+            Motion::Fast => (k.w, wn),
+            Motion::Slow => (slow_w, fmath::norm3(slow_w)),
+        };
+        let v_on = v_norm > 0.0 && v_norm >= REL_ACTIVE * self.v_peak && v_norm >= ARM_M * wn;
+        let w_on = w_norm > 0.0 && w_norm >= REL_ACTIVE * self.w_peak;
+        self.lin = signs(v, v_on, self.lin);
+        self.ang = signs(w, w_on, self.ang);
         token_from_signs(self.lin, self.ang)
     }
 
