@@ -366,6 +366,11 @@ pub struct CheckArgs {
     /// Seed of the doodles `--defaults` generates.
     #[arg(long, default_value_t = 5)]
     pub seed: u64,
+    /// With `--defaults`: also draw one sheet per action into this folder (`ACTION.png`), a
+    /// row of stick figures per effort (sudden-strong, sudden-light, sustained-strong,
+    /// sustained-light, neutral), to see what each effort does to it.
+    #[arg(long, requires = "defaults")]
+    pub sheets: Option<PathBuf>,
     /// The ground: a height in metres, or `auto` (a low percentile of the feet's height).
     #[arg(long, default_value = "0")]
     pub ground: String,
@@ -377,47 +382,14 @@ pub struct CheckArgs {
 /// Every default action in the four effort corners and neutral, each assembled along a
 /// doodle generated at `seed` from its label (as `figurine animate --labels` does), judged.
 pub fn check_defaults(seed: u64) -> Result<Vec<Plausibility>> {
-    use super::assemble::{assemble_guided, AssembleOptions};
-    use crate::synth::{gesture, Action, Effort, Knobs, TimeClass, WeightClass};
-    let library = super::library::ClipLibrary::default_library()?;
-    let efforts = [
-        (
-            "sudden-strong",
-            Effort::new(TimeClass::Sudden, WeightClass::Strong),
-        ),
-        (
-            "sudden-light",
-            Effort::new(TimeClass::Sudden, WeightClass::Light),
-        ),
-        (
-            "sustained-strong",
-            Effort::new(TimeClass::Sustained, WeightClass::Strong),
-        ),
-        (
-            "sustained-light",
-            Effort::new(TimeClass::Sustained, WeightClass::Light),
-        ),
-        ("neutral", Effort::NEUTRAL),
-    ];
-    let mut rows = Vec::new();
-    for action in Action::ALL {
-        for (name, effort) in efforts {
-            let d = gesture(seed, &Knobs::default(), action, effort);
-            let events = super::cli::label_events(d.labels.clone());
-            let clips = library.load(events.iter().map(|e| e.action.as_str()))?;
-            let asm = assemble_guided(
-                &events,
-                Some(&d.log),
-                &clips,
-                library.forward(),
-                &AssembleOptions::default(),
-                None,
-            )?;
-            let label = format!("{} {name}", action.name());
-            rows.push(check_clip(&asm.clip, Ground::At(0.0), &label)?);
-        }
-    }
-    Ok(rows)
+    let (anims, _) = super::defaults::default_animations(seed)?;
+    anims
+        .iter()
+        .map(|a| {
+            let label = format!("{} {}", a.action, a.effort);
+            check_clip(&a.assembly.clip, Ground::At(0.0), &label)
+        })
+        .collect()
 }
 
 /// The real takes of the data folder (BVH files, DeepMimic clips), judged with the ground
@@ -473,7 +445,15 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         rows.extend(check_reference()?);
     }
     if a.defaults {
-        rows.extend(check_defaults(a.seed)?);
+        let (anims, forward) = super::defaults::default_animations(a.seed)?;
+        for anim in &anims {
+            let label = format!("{} {}", anim.action, anim.effort);
+            rows.push(check_clip(&anim.assembly.clip, Ground::At(0.0), &label)?);
+        }
+        if let Some(dir) = &a.sheets {
+            let written = super::defaults::write_effort_sheets(&anims, forward, dir)?;
+            eprintln!("{} effort sheets in {}", written.len(), dir.display());
+        }
     }
     for path in &a.clips {
         rows.push(check_path(path, ground)?);

@@ -26,6 +26,7 @@ pub mod check;
 pub mod cli;
 pub mod clip_spec;
 pub mod contact;
+pub mod defaults;
 pub mod effort;
 pub mod graph_cuts;
 pub mod joint_limits;

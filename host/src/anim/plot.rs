@@ -63,40 +63,108 @@ pub fn contact_sheet(clip: &Clip, frames: &[usize], target: &[Vec3], forward: Ve
                 Rgb([0, 0, 0]),
             );
         }
-        let fwd = r.rotation * forward;
-        let fwd = Vec2::new(fwd.x, fwd.z).normalize_or(Vec2::X);
-        let base = Vec2::new(r.position.x, r.position.z);
+        let s = (k as f32 / n * 180.0) as u8;
         let cx = PANEL + (k as u32 % 4) * CELL;
         let cy = (k as u32 / 4) * CELL;
-        let to_px = |p: Vec3| -> (f32, f32) {
-            let h = (Vec2::new(p.x, p.z) - base).dot(fwd);
-            let scale = CELL as f32 / CELL_SPAN_M;
-            (
-                cx as f32 + CELL as f32 / 2.0 + h * scale,
-                cy as f32 + CELL as f32 - 8.0 - p.y * scale,
-            )
-        };
-        line(
+        draw_figure(
             &mut img,
-            (cx as f32, to_px(Vec3::ZERO).1),
-            ((cx + CELL - 1) as f32, to_px(Vec3::ZERO).1),
-            Rgb([150, 150, 150]),
+            clip,
+            f,
+            (cx, cy),
+            Rgb([s, s / 2, 255 - s]),
+            forward,
         );
-        let s = (k as f32 / n * 180.0) as u8;
-        let color = Rgb([s, s / 2, 255 - s]);
-        for (j, joint) in clip.skeleton.joints.iter().enumerate() {
-            if let Some(par) = joint.parent {
-                if let (Some(a), Some(b)) = (world.get(j), world.get(par)) {
-                    line(&mut img, to_px(a.position), to_px(b.position), color);
-                }
-            }
-        }
         // Cell frame.
         for x in cx..cx + CELL {
             put(&mut img, x as i64, cy as i64, Rgb([220, 220, 220]));
         }
         for y in cy..cy + CELL {
             put(&mut img, cx as i64, y as i64, Rgb([220, 220, 220]));
+        }
+    }
+    img
+}
+
+/// Draws frame `f` of `clip` as a stick figure seen from its side (horizontal axis = its
+/// facing, from the rig's `forward` carried by the root) over the ground line, in the
+/// [`CELL`]-sized cell whose top-left pixel is `cell`; the figure's root sits at the cell's
+/// horizontal centre.
+fn draw_figure(
+    img: &mut RgbImage,
+    clip: &Clip,
+    f: usize,
+    cell: (u32, u32),
+    color: Rgb<u8>,
+    forward: Vec3,
+) {
+    let Some(frame) = clip.frames.get(f) else {
+        return;
+    };
+    let world = clip.skeleton.forward(frame);
+    let Some(r) = world.first() else { return };
+    let fwd = r.rotation * forward;
+    let fwd = Vec2::new(fwd.x, fwd.z).normalize_or(Vec2::X);
+    let base = Vec2::new(r.position.x, r.position.z);
+    let (cx, cy) = cell;
+    let to_px = |p: Vec3| -> (f32, f32) {
+        let h = (Vec2::new(p.x, p.z) - base).dot(fwd);
+        let scale = CELL as f32 / CELL_SPAN_M;
+        (
+            cx as f32 + CELL as f32 / 2.0 + h * scale,
+            cy as f32 + CELL as f32 - 8.0 - p.y * scale,
+        )
+    };
+    line(
+        img,
+        (cx as f32, to_px(Vec3::ZERO).1),
+        ((cx + CELL - 1) as f32, to_px(Vec3::ZERO).1),
+        Rgb([150, 150, 150]),
+    );
+    for (j, joint) in clip.skeleton.joints.iter().enumerate() {
+        if let Some(par) = joint.parent {
+            if let (Some(a), Some(b)) = (world.get(j), world.get(par)) {
+                line(img, to_px(a.position), to_px(b.position), color);
+            }
+        }
+    }
+}
+
+/// Draws one row per `(clip, frames)` pair: `per_row` stick figures (as in
+/// [`contact_sheet`]) at frames evenly spaced over the range, dark → light in time, each in
+/// its own [`CELL`]. Rows set side by side let a reader compare versions of one motion (the
+/// effort sheets of `figurine check --defaults --sheets`).
+pub fn effort_sheet(
+    rows: &[(&Clip, std::ops::RangeInclusive<usize>)],
+    per_row: usize,
+    forward: Vec3,
+) -> RgbImage {
+    let per_row = per_row.max(1);
+    let mut img = RgbImage::from_pixel(
+        per_row as u32 * CELL,
+        rows.len().max(1) as u32 * CELL,
+        Rgb([255, 255, 255]),
+    );
+    for (i, (clip, span)) in rows.iter().enumerate() {
+        let (a, b) = (
+            *span.start(),
+            (*span.end()).min(clip.len().saturating_sub(1)),
+        );
+        for k in 0..per_row {
+            let u = if per_row > 1 {
+                k as f32 / (per_row - 1) as f32
+            } else {
+                0.0
+            };
+            let f = a + (u * b.saturating_sub(a) as f32).round() as usize;
+            let s = (u * 180.0) as u8;
+            let cell = (k as u32 * CELL, i as u32 * CELL);
+            draw_figure(&mut img, clip, f, cell, Rgb([s, s / 2, 255 - s]), forward);
+            for x in cell.0..cell.0 + CELL {
+                put(&mut img, x as i64, cell.1 as i64, Rgb([220, 220, 220]));
+            }
+            for y in cell.1..cell.1 + CELL {
+                put(&mut img, cell.0 as i64, y as i64, Rgb([220, 220, 220]));
+            }
         }
     }
     img
