@@ -18,7 +18,7 @@ use super::source::{load_clip, load_clips, GraphClip};
 use super::style::ComponentWeights;
 use super::synth::{best_start, plan, reference_style, render, Chooser, Rng};
 use super::tile::run_tile;
-use super::{peak_memory_mib, GraphError, FPS, WINDOW};
+use super::{cpu_seconds, peak_memory_mib, GraphError, FPS, WINDOW};
 
 /// Style-coherent motion graphs (seed 003).
 #[derive(Args, Debug)]
@@ -359,13 +359,14 @@ fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
 fn tile_cmd(a: TileArgs) -> anyhow::Result<()> {
     let r = run_tile(&a.job, a.index, !a.quiet)?;
     println!(
-        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.2} s, search {:.2} s, peak {:.0} MiB; wrote {}",
+        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.2} s, search {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
         a.index,
         r.kernels,
         r.found.pairs,
         r.found.candidates.len(),
         r.read_seconds,
         r.search_seconds,
+        cpu_seconds().unwrap_or(f64::NAN),
         peak_memory_mib().unwrap_or(f64::NAN),
         r.path.display()
     );
@@ -391,7 +392,7 @@ fn merge_cmd(a: MergeArgs) -> anyhow::Result<()> {
     })?;
     if !a.quiet {
         println!(
-            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.2} s, style {:.2} s, total {:.2} s, peak {:.0} MiB; wrote {}",
+            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.2} s, style {:.2} s, total {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
             st.tiles,
             st.pairs,
             st.local_minima,
@@ -399,6 +400,7 @@ fn merge_cmd(a: MergeArgs) -> anyhow::Result<()> {
             st.read_seconds,
             st.assemble_seconds,
             t0.elapsed().as_secs_f64(),
+            cpu_seconds().unwrap_or(f64::NAN),
             peak_memory_mib().unwrap_or(f64::NAN),
             a.out.display()
         );

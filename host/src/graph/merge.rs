@@ -147,10 +147,17 @@ mod tests {
         assert!(!built.edges.is_empty());
         let planned = plan_job(&clips(), &Default::default(), &params(), 64, &dir).unwrap();
         assert_eq!(planned.manifest.tiles.len(), 21);
-        // Reverse order, one tile twice: order and repetition change nothing.
-        for i in (0..21).rev().chain([5]) {
+        // Reverse order, one tile again and twice at once: order and repetition change nothing.
+        for i in (0..21).rev() {
             run_tile(&dir, i, false).unwrap();
         }
+        let before = std::fs::read(tile_path(&dir, 5)).unwrap();
+        std::thread::scope(|s| {
+            let a = s.spawn(|| run_tile(&dir, 5, false).map(|_| ()));
+            let b = s.spawn(|| run_tile(&dir, 5, false).map(|_| ()));
+            assert!(a.join().unwrap().is_ok() && b.join().unwrap().is_ok());
+        });
+        assert_eq!(std::fs::read(tile_path(&dir, 5)).unwrap(), before);
         let (merged, st) = merge_job(&dir).unwrap();
         assert_eq!(st.tiles, 21);
         assert_eq!(bytes(&merged, &dir, "m.bin"), bytes(&built, &dir, "b.bin"));

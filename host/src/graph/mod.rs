@@ -63,6 +63,17 @@ pub fn peak_memory_mib() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
+/// CPU time this process has used so far, user + system over all threads, seconds (from
+/// /proc/self/stat at Linux's 100 ticks per second; None where there is no such file). On a
+/// shared machine it measures work where wall time also measures the neighbours.
+pub fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let mut f = s.get(s.rfind(')')? + 1..)?.split_whitespace();
+    let utime: f64 = f.nth(11)?.parse().ok()?;
+    let stime: f64 = f.next()?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
 /// Why a motion-graph step failed.
 #[derive(Debug, Error)]
 pub enum GraphError {

@@ -40,11 +40,17 @@ pub const TILES_DIR: &str = "tiles";
 pub const JOB_FORMAT: &str = "figurine-graph-job";
 /// Version of the job layout (manifest, tile files) this build writes and reads.
 pub const JOB_VERSION: u32 = 1;
-/// Default band, frames (tiles of 16384² window pairs: seconds each on a few cores, and a
-/// 4 M-frame library stays near Slurm's default array limit only with larger bands).
-pub const DEFAULT_BAND: usize = 16_384;
+/// Default band, frames: a tile of 65,536² window pairs lasts about 23 s on 2 cores (5.3 ns per
+/// pair measured), long beside Slurm's ≈ 1 s per-task latency; smaller bands make more, shorter
+/// tiles whose latency shows (`cargo xtask bench`). A 4 M-frame library makes 1,953 tiles with
+/// it: raise Slurm's MaxArraySize or plan with `--band 131072` (496 tiles).
+pub const DEFAULT_BAND: usize = 65_536;
 /// Most frames a job may have (global frames are u32 in the graph and tile files).
 pub const MAX_FRAMES: usize = u32::MAX as usize;
+/// Most kernel tiles along one side of a band (band ÷ tile side): a job tile holds at most
+/// its square, 4 M kernel tiles, so its list of work stays small (with 256-window kernel tiles,
+/// bands up to 524,288 frames).
+pub const MAX_KERNELS_PER_BAND: usize = 2048;
 
 /// One job tile: window centres `rows` × `cols` (global frames, half-open).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -150,14 +156,9 @@ impl Manifest {
                 self.frames, self.windows
             ));
         }
-        if self.band == 0 || self.band % kernel_side(p) != 0 {
-            return Err(format!(
-                "band {} is not a positive multiple of the tile side {}",
-                self.band,
-                kernel_side(p)
-            ));
-        }
-        if self.tiles != tile_list(self.frames, self.band) {
+        check_band(self.band, p)?;
+        let b = self.frames.div_ceil(self.band);
+        if self.tiles.len() != b * (b + 1) / 2 || self.tiles != tile_list(self.frames, self.band) {
             return Err("the tile list does not match the frames and band".into());
         }
         if self.store_version > STORE_VERSION {
@@ -168,6 +169,18 @@ impl Manifest {
         }
         Ok(())
     }
+}
+
+/// A band must be a positive multiple of the kernel tile side, at most
+/// [`MAX_KERNELS_PER_BAND`] of them.
+fn check_band(band: usize, p: &BuildParams) -> Result<(), String> {
+    let side = kernel_side(p);
+    if band == 0 || !band.is_multiple_of(side) || band / side > MAX_KERNELS_PER_BAND {
+        return Err(format!(
+            "band {band} frames is not a positive multiple of the tile side ({side} windows) of at most {MAX_KERNELS_PER_BAND} tiles"
+        ));
+    }
+    Ok(())
 }
 
 /// Parses and checks a manifest's bytes; errors name `path`. A manifest from a newer
@@ -217,12 +230,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), GraphError> {
         path: path.to_path_buf(),
         source,
     };
-    // Host name and pid: two writers of the same file (a tile run twice at once, on one machine
-    // or two sharing the folder) never share a temporary file.
+    // Host name, pid and a counter: two writers of the same file (a tile run twice at once, on
+    // one machine or two sharing the folder, or two threads) never share a temporary file.
+    static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let k = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
     let tmp = path.with_file_name(format!(
-        ".{}.{}.{}.tmp",
+        ".{}.{}.{}.{k}.tmp",
         name.unwrap_or_default(),
         host.trim(),
         std::process::id()
@@ -262,12 +277,7 @@ pub fn plan_job(
     job: &Path,
 ) -> Result<Planned, GraphError> {
     check_clips(clips)?;
-    let side = kernel_side(p);
-    if band == 0 || band % side != 0 {
-        return Err(GraphError::Invalid(format!(
-            "--band {band} must be a positive multiple of the tile side ({side} windows)"
-        )));
-    }
+    check_band(band, p).map_err(|e| GraphError::Invalid(format!("--band: {e}")))?;
     let rows = FrameRows::from_clips(clips);
     if rows.len() > MAX_FRAMES {
         return Err(GraphError::Invalid(format!(

@@ -62,7 +62,7 @@ pub fn scripts(
          # Merges graph job {plan} once every tile task succeeded.\n\
          set -eu\n\
          export RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"\n\
-         exec \"${{FIGURINE:-{eq}}}\" graph merge {jq} --out {gq} --quiet\n",
+         exec \"${{FIGURINE:-{eq}}}\" graph merge {jq} --out {gq}\n",
         logs = logs.display(),
         plan = m.plan,
     );
