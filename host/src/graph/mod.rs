@@ -17,7 +17,7 @@
 //! - [`effort`]: Laban Effort (Lt, Lw) from the Effort-component measurements, for choosing
 //!   clip variants and transitions by a recognised effort.
 //! - [`eval`]: the paper's §5.2–5.3 evaluation (label costs, transition counts).
-//! - [`cli`]: `figurine graph build | plan | tile | merge | synth | eval`.
+//! - [`cli`]: `figurine graph build | synth | eval`; `job_cli`: `figurine graph plan | tile | merge`.
 
 use std::path::PathBuf;
 
@@ -29,6 +29,7 @@ pub mod effort;
 pub mod eval;
 #[allow(clippy::module_inception)]
 pub mod graph;
+mod job_cli;
 pub mod lma;
 pub mod merge;
 pub mod plan;
