@@ -5,12 +5,25 @@
 //! process (so each peak-memory figure, VmHWM from /proc/self/status, is its own) and prints a
 //! table; `… -- FRAMES` runs one size. Needs the data of `cargo xtask setup` (or
 //! FIGURINE_DATA_DIR).
+//!
+//! `… -- engine [FRAMES]` (default 54,000) compares `graph build` with the same job planned,
+//! run as a Slurm job array on a single-node cluster started for it (see
+//! `tests/support/slurm.rs`; needs root and the `slurm-wlm` and `munge` packages) and merged;
+//! it prints the engine's overhead, time and memory per tile, merge time and memory, the
+//! feature store's size, and a scale model for 4 M frames. It needs the release `figurine`
+//! binary beside the examples folder (`cargo build --release -p figurine-host --bin figurine`).
 
 use std::process::Command;
 use std::time::Instant;
 
+#[path = "support/graph_engine.rs"]
+mod engine;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use figurine_host::data::require_data_file;
 use figurine_host::graph::build::{build_graph, BuildParams};
+use figurine_host::graph::plan::DEFAULT_BAND;
 use figurine_host::graph::source::load_clips;
 use figurine_host::graph::{GraphClip, Variant};
 
@@ -24,16 +37,10 @@ const FILES: [&str; 6] = [
 ];
 const SIZES: [usize; 3] = [10_000, 27_000, 54_000];
 
-/// Peak resident memory of this process, MiB (VmHWM).
-fn peak_mib() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / 1024.0)
-}
+use figurine_host::graph::peak_memory_mib as peak_mib;
 
 /// The library repeated (and the last copy cut) to exactly `frames` frames.
-fn library(base: &[GraphClip], frames: usize) -> Vec<GraphClip> {
+pub fn library(base: &[GraphClip], frames: usize) -> Vec<GraphClip> {
     let mut out = Vec::new();
     let mut total = 0;
     'outer: for rep in 0.. {
@@ -82,7 +89,25 @@ fn one(frames: usize) -> anyhow::Result<()> {
 }
 
 fn main() -> anyhow::Result<()> {
-    if let Some(arg) = std::env::args().nth(1) {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("engine") {
+        let paths = FILES
+            .iter()
+            .map(|f| require_data_file("bvh", f))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let base = load_clips(&paths, &Default::default())?;
+        // 54k frames cut into 10, 3 and 1 tiles (the default band), then a library twice as
+        // large in 3 tiles of the default band, long enough for Slurm's latency to fade.
+        println!("54,000 frames:");
+        engine::run(
+            &library(&base, 54_000),
+            &[16_384, 27_136, DEFAULT_BAND],
+            true,
+        )?;
+        println!("\n108,000 frames:");
+        return engine::run(&library(&base, 108_000), &[DEFAULT_BAND], false);
+    }
+    if let Some(arg) = args.first() {
         return one(arg.parse()?);
     }
     println!(

@@ -46,7 +46,7 @@ enum Command {
     Check(anim::check::CheckArgs),
     /// Inspect motion clips (`clip stages CLIP`).
     Clip(anim::cli::ClipArgs),
-    /// Style-coherent motion graphs: build, synth, eval (seed 003).
+    /// Style-coherent motion graphs: build (or plan, tile, merge across machines), synth, eval (seed 003).
     Graph(graph::cli::GraphArgs),
     /// Render an animation headless to a GIF, MP4, PNG still or folder of PNG frames.
     #[cfg(feature = "render")]

@@ -99,5 +99,28 @@ pub fn bench() -> Result<()> {
     step("motion graph build at ~10k/27k/54k frames (cargo run --release -p figurine-host --example graph_bench)");
     host_example("graph_bench")?;
 
+    step("distributed motion graph, 54k frames: graph build vs a Slurm job array of tiles and a dependent merge (cargo run --release -p figurine-host --example graph_bench -- engine)");
+    // The job array runs the release `figurine` binary.
+    run(cargo().args([
+        "build",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--bin",
+        "figurine",
+    ]))?;
+    run(cargo().args([
+        "run",
+        "-q",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--example",
+        "graph_bench",
+        "--",
+        "engine",
+    ]))?;
+
     Ok(())
 }

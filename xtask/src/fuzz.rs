@@ -92,6 +92,19 @@ const TARGETS: &[Target] = &[
         real_seeds: &[("@host/assets", "effort.json")],
         max_len: 0,
     },
+    // Seeds (host/fuzz/seeds/): a manifest and a tile of a DeepMimic plan.
+    Target {
+        dir: "host/fuzz",
+        name: "graph_manifest",
+        real_seeds: &[],
+        max_len: 0,
+    },
+    Target {
+        dir: "host/fuzz",
+        name: "graph_tile",
+        real_seeds: &[],
+        max_len: 0,
+    },
     Target {
         dir: "firmware/recognizer/fuzz",
         name: "sample_feed",

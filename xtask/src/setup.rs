@@ -4,7 +4,8 @@
 //! * Debian packages, installed only when missing: `qemu-system-arm` (firmware end-to-end
 //!   tests), `mesa-vulkan-drivers` + `libvulkan1` (lavapipe, headless rendering), `ffmpeg`
 //!   (MP4 output), `python3-venv`, `nodejs` + `npm` (independent BVH and glTF validators),
-//!   `g++` (libFuzzer, which cargo-fuzz builds from C++ sources).
+//!   `g++` (libFuzzer, which cargo-fuzz builds from C++ sources), `slurm-wlm` + `munge` (the
+//!   Slurm job array of the distributed graph build, tests/graph_tiles.rs and the bench).
 //! * Validators used by tests: Python's `bvh` package in `target/tools/pyenv`, Khronos'
 //!   `gltf-validator` from npm in `target/tools/node`.
 //! * cargo-fuzz from crates.io when missing (the fuzz smoke of `cargo xtask test`).
@@ -26,6 +27,11 @@ const APT_PACKAGES: &[(&str, &str)] = &[
     ("nodejs", "node"),
     ("npm", "npm"),
     ("g++", "g++"),
+    // A single-node Slurm cluster for the distributed graph build's test and benchmark (each
+    // starts its own munged, slurmctld and slurmd in a temporary folder; no system service is
+    // configured or needed).
+    ("slurm-wlm", ""),
+    ("munge", ""),
 ];
 
 fn dpkg_installed(pkg: &str) -> bool {

@@ -1,4 +1,4 @@
-//! `figurine graph build | synth | eval`.
+//! `figurine graph build | synth | eval`, and the subcommands of [`super::job_cli`].
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -10,8 +10,9 @@ use crate::motion::{write_bvh_path, write_glb_path};
 use super::build::{build_graph, BuildParams};
 use super::eval::{evaluate, read_labels};
 use super::graph::{MotionGraph, Variant};
+use super::job_cli::{merge_cmd, plan_cmd, tile_cmd, MergeArgs, PlanArgs, TileArgs};
 use super::roles::{read_overrides, RoleOverrides};
-use super::source::{load_clip, load_clips};
+use super::source::{load_clip, load_clips, GraphClip};
 use super::style::ComponentWeights;
 use super::synth::{best_start, plan, reference_style, render, Chooser, Rng};
 use super::{GraphError, FPS, WINDOW};
@@ -25,8 +26,14 @@ pub struct GraphArgs {
 
 #[derive(Subcommand, Debug)]
 enum GraphCommand {
-    /// Build a graph from BVH / DeepMimic clips (files or folders).
+    /// Build a graph from BVH / DeepMimic clips (files or folders), on this machine.
     Build(BuildArgs),
+    /// Plan a distributed build: features, manifest and Slurm scripts into a job folder.
+    Plan(PlanArgs),
+    /// Compute one tile of a planned job (a Slurm array task runs one).
+    Tile(TileArgs),
+    /// Merge a job's tiles into the graph file (byte-identical to `graph build`).
+    Merge(MergeArgs),
     /// Synthesise a motion by walking a graph.
     Synth(SynthArgs),
     /// Evaluate MG vs LMA-MG with per-clip labels (§5.2–5.3).
@@ -41,6 +48,13 @@ struct BuildArgs {
     /// Output graph file.
     #[arg(long)]
     out: PathBuf,
+    #[command(flatten)]
+    opts: BuildOpts,
+}
+
+// Options shared by `graph build` and `graph plan`.
+#[derive(Args, Debug)]
+pub(super) struct BuildOpts {
     /// Role override file: JSON object role → joint name (e.g. {"left_hand": "forearm.L_end"}).
     #[arg(long)]
     roles: Option<PathBuf>,
@@ -53,7 +67,7 @@ struct BuildArgs {
     /// LMA component weights body,effort,shape,space.
     #[arg(long, default_value = "0.25,0.25,0.25,0.25")]
     weights: String,
-    /// Tile side in windows.
+    /// Kernel tile side in windows.
     #[arg(long, default_value_t = 256)]
     tile: usize,
     /// Hide progress bars.
@@ -143,23 +157,30 @@ fn overrides(path: Option<&Path>) -> Result<RoleOverrides, GraphError> {
 pub fn run(args: GraphArgs) -> anyhow::Result<()> {
     match args.command {
         GraphCommand::Build(a) => build(a),
+        GraphCommand::Plan(a) => plan_cmd(a),
+        GraphCommand::Tile(a) => tile_cmd(a),
+        GraphCommand::Merge(a) => merge_cmd(a),
         GraphCommand::Synth(a) => synth(a),
         GraphCommand::Eval(a) => eval(a),
     }
 }
 
-fn build(a: BuildArgs) -> anyhow::Result<()> {
-    for (name, t) in [("--t-mg", a.t_mg), ("--t-lma", a.t_lma)] {
+/// Clips, role overrides and parameters from the shared build options.
+pub(super) fn load(
+    inputs: &[PathBuf],
+    o: &BuildOpts,
+) -> anyhow::Result<(Vec<GraphClip>, RoleOverrides, BuildParams)> {
+    for (name, t) in [("--t-mg", o.t_mg), ("--t-lma", o.t_lma)] {
         anyhow::ensure!(
             (0.0..=1.0).contains(&t),
             "{name} must be within 0..1, got {t}"
         );
     }
-    let weights = ComponentWeights::parse(&a.weights).map_err(anyhow::Error::msg)?;
-    let roles = overrides(a.roles.as_deref())?;
-    let files = expand_inputs(&a.clips)?;
+    let weights = ComponentWeights::parse(&o.weights).map_err(anyhow::Error::msg)?;
+    let roles = overrides(o.roles.as_deref())?;
+    let files = expand_inputs(inputs)?;
     let given = || {
-        a.clips
+        inputs
             .iter()
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
@@ -170,7 +191,6 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         "no clip files (.bvh, DeepMimic .txt) in {}",
         given()
     );
-    let t0 = Instant::now();
     let clips = load_clips(&files, &roles)?;
     anyhow::ensure!(
         !clips.is_empty(),
@@ -186,13 +206,19 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         );
     }
     let p = BuildParams {
-        t_mg: a.t_mg,
-        t_lma: a.t_lma,
+        t_mg: o.t_mg,
+        t_lma: o.t_lma,
         weights,
-        tile: a.tile,
-        progress: !a.quiet,
+        tile: o.tile,
+        progress: !o.quiet,
         ..BuildParams::default()
     };
+    Ok((clips, roles, p))
+}
+
+fn build(a: BuildArgs) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let (clips, roles, p) = load(&a.clips, &a.opts)?;
     let (mut g, st) = build_graph(&clips, &p)?;
     g.roles = roles;
     g.save(&a.out)?;
@@ -213,8 +239,8 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     );
     println!(
         "transitions: MG {mg} (T_MG {}), LMA-MG {lma} (T_LMA {}), pruned {:.1}%",
-        a.t_mg,
-        a.t_lma,
+        p.t_mg,
+        p.t_lma,
         if mg > 0 {
             100.0 * (1.0 - lma as f64 / mg as f64)
         } else {

@@ -7,13 +7,17 @@
 //! - [`lma`]: the 29 LMA features of Table 1 → 114 measurements per 35-frame window.
 //! - [`posture`]: eq. 1, Kovar's posture distance with the closed-form 2-D alignment.
 //! - [`style`]: eq. 2, Pearson style correlation per LMA component, weights, Gaussian smoothing.
-//! - [`build`]: the tiled, multi-core, streaming O(N²) candidate search (never an N×N matrix).
+//! - [`search`]: the tiled, streaming O(N²) posture search (never an N×N matrix).
+//! - [`build`]: the single-machine build: features, every kernel tile on both cores, assembly.
+//! - [`store`]: the per-frame / per-window feature store of a distributed job (Arrow IPC).
+//! - [`plan`], [`tile`], [`merge`]: the build split into independent tiles for many machines;
+//!   [`slurm`] writes the Slurm job array that runs them.
 //! - [`graph`]: nodes, transition edges, blends, strongly connected trimming, the file format.
 //! - [`synth`]: synthesis by highest similarity (§5.3) and by example (§5.4).
 //! - [`effort`]: Laban Effort (Lt, Lw) from the Effort-component measurements, for choosing
 //!   clip variants and transitions by a recognised effort.
 //! - [`eval`]: the paper's §5.2–5.3 evaluation (label costs, transition counts).
-//! - [`cli`]: `figurine graph build | synth | eval`.
+//! - [`cli`]: `figurine graph build | synth | eval`; `job_cli`: `figurine graph plan | tile | merge`.
 
 use std::path::PathBuf;
 
@@ -25,12 +29,19 @@ pub mod effort;
 pub mod eval;
 #[allow(clippy::module_inception)]
 pub mod graph;
+mod job_cli;
 pub mod lma;
+pub mod merge;
+pub mod plan;
 pub mod posture;
 pub mod roles;
+pub mod search;
+pub mod slurm;
 pub mod source;
+pub mod store;
 pub mod style;
 pub mod synth;
+pub mod tile;
 
 pub use build::{build_graph, BuildParams};
 pub use graph::{Edge, MotionGraph, Variant};
@@ -43,6 +54,26 @@ pub const FPS: f32 = 30.0;
 pub const WINDOW: usize = 35;
 /// Frames on each side of a window's centre frame.
 pub const HALF: usize = WINDOW / 2;
+
+/// Peak resident memory of this process so far, MiB (VmHWM from /proc/self/status; None where
+/// there is no such file).
+pub fn peak_memory_mib() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// CPU time this process has used so far, user + system over all threads, seconds (from
+/// /proc/self/stat at Linux's 100 ticks per second; None where there is no such file). On a
+/// shared machine it measures work where wall time also measures the neighbours.
+pub fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let mut f = s.get(s.rfind(')')? + 1..)?.split_whitespace();
+    let utime: f64 = f.nth(11)?.parse().ok()?;
+    let stime: f64 = f.next()?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
 
 /// Why a motion-graph step failed.
 #[derive(Debug, Error)]

@@ -1,0 +1,3 @@
+//! Helpers shared by integration tests and benchmark examples.
+
+pub mod slurm;
