@@ -26,6 +26,9 @@ const APT_PACKAGES: &[(&str, &str)] = &[
     ("nodejs", "node"),
     ("npm", "npm"),
     ("g++", "g++"),
+    // The AprilTag detector behind `figurine track` (apriltag-sys finds it with pkg-config).
+    ("libapriltag-dev", ""),
+    ("pkg-config", "pkg-config"),
 ];
 
 fn dpkg_installed(pkg: &str) -> bool {
