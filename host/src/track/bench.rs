@@ -34,6 +34,9 @@ pub struct BenchArgs {
     /// Keep the videos and logs here (default: a temporary folder, removed).
     #[arg(long)]
     pub keep: Option<PathBuf>,
+    /// Track without smoothing the orientation (`figurine track --raw`).
+    #[arg(long)]
+    pub raw: bool,
 }
 
 /// One gesture tracked.
@@ -72,6 +75,7 @@ pub fn run_gesture(
     action: Action,
     seed: u64,
     dir: &std::path::Path,
+    smooth: bool,
 ) -> Result<GestureRun> {
     let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
     let effort = Effort::random_state(&mut pick);
@@ -80,7 +84,7 @@ pub fn run_gesture(
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
     let truths = render_video(setup, &sc, &placed, &video)?;
-    let run = track_video(setup, Family::Tag36h11, 0, &video)?;
+    let run = track_video(setup, Family::Tag36h11, 0, &video, smooth)?;
     let frames = compare(&truths, &run.log);
     let (lib, blob) = load_library(None)?;
     let effort_model = load_effort(None)?;
@@ -112,10 +116,10 @@ pub fn run_gesture(
 fn row(out: &mut String, label: &str, s: &Summary) {
     let _ = writeln!(
         out,
-        "| {label} | {} | {:.1} % ({:.1} % of unoccluded) | {:.1} / {:.1} | {:.2} / {:.2} |",
+        "| {label} | {} | {:.1} % ({:.1} % of frames in sight) | {:.1} / {:.1} | {:.2} / {:.2} |",
         s.frames,
         100.0 * s.lost as f64 / s.frames.max(1) as f64,
-        100.0 * s.lost_clear_share(),
+        100.0 * s.lost_visible_share(),
         s.pos_median_mm,
         s.pos_p90_mm,
         s.ori_median_deg,
@@ -239,7 +243,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
-            let r = run_gesture(&setup, action, seed, &dir)?;
+            let r = run_gesture(&setup, action, seed, &dir, !args.raw)?;
             let s = summarize(&r.frames);
             eprintln!(
                 "{:>9} at {distance:.2} m: {} frames, {:.1} % lost, {:.1} mm, {:.2}°, truth {:?}, tracked {:?}",

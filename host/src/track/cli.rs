@@ -77,6 +77,10 @@ pub struct RunArgs {
     /// Detector threads.
     #[arg(long, default_value_t = 1)]
     pub threads: u32,
+    /// Write the orientation as measured, without the adaptive smoothing that keeps a still
+    /// figurine from jittering by a degree or two.
+    #[arg(long)]
+    pub raw: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -98,6 +102,22 @@ enum TrackCommand {
         /// PNG pixels per cell (the file's density keeps the printed size whatever this is).
         #[arg(long, default_value_t = 40)]
         px_per_cell: u32,
+    },
+    /// Measure the camera's focal length from a video of the tag turned through different
+    /// tilts (10+ frames tilted 15° or more), and write CAL.json for `--calibration`.
+    Calibrate {
+        /// The video (record it with the webcam at the size you will track at).
+        #[arg(long)]
+        video: PathBuf,
+        /// The tag's id.
+        #[arg(long, default_value_t = 0)]
+        tag_id: u32,
+        /// Tag family.
+        #[arg(long, value_enum, default_value = "tag36h11")]
+        family: Family,
+        /// Output calibration (JSON).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Render a test video: the tag on a figurine moving along a pose log, seen by a webcam.
     Render(RenderArgs),
@@ -140,6 +160,10 @@ pub struct RenderArgs {
     /// No blur, noise, light changes or occlusion.
     #[arg(long)]
     clean: bool,
+    /// Take the log as it is, already in the camera's world frame (origin at the camera, +Y
+    /// up, +Z toward the camera: a tracked log), instead of moving it in front of the camera.
+    #[arg(long, conflicts_with = "distance")]
+    as_is: bool,
 }
 
 /// `figurine track …`.
@@ -152,10 +176,36 @@ pub fn run(args: &TrackArgs) -> Result<()> {
             out,
             px_per_cell,
         }) => print_tag(*family, *id, *size, out, *px_per_cell),
+        Some(TrackCommand::Calibrate {
+            video,
+            tag_id,
+            family,
+            out,
+        }) => calibrate(video, *family, *tag_id, out),
         Some(TrackCommand::Render(r)) => render(r),
         Some(TrackCommand::Bench(b)) => super::bench::run(b),
         None => track(&args.run),
     }
+}
+
+fn calibrate(video: &Path, family: Family, id: u32, out: &Path) -> Result<()> {
+    let (views, width, height) = super::calibrate::corners_from_video(video, family, id)?;
+    let cal = super::calibrate::calibrate(&views, width, height)?;
+    let text = serde_json::to_string_pretty(&cal)?;
+    std::fs::write(out, text + "\n").map_err(|source| TrackError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let fov = 2.0 * (width as f64 / 2.0 / cal.fx).atan().to_degrees();
+    eprintln!(
+        "{}: f = {:.1} px at {width}×{height} (horizontal field of view {fov:.1}°), \
+         corners fit to {:.2} px RMS over {} views",
+        out.display(),
+        cal.fx,
+        cal.rms_px.unwrap_or(f64::NAN),
+        views.len()
+    );
+    Ok(())
 }
 
 fn print_tag(family: Family, id: u32, size: f64, out: &Path, px: u32) -> Result<()> {
@@ -207,19 +257,27 @@ fn render(a: &RenderArgs) -> Result<()> {
         seed: a.seed,
         ..Setup::default()
     };
-    let placed = place(&log, setup.distance);
+    let placed = if a.as_is {
+        log
+    } else {
+        place(&log, setup.distance)
+    };
     let sc = scene(&setup, Family::Tag36h11, a.tag_id)?;
     let frames = render_video(&setup, &sc, &placed, &a.out)?;
     if let Some(path) = &a.truth {
         super::eval::truth_log(&frames).write_path(path)?;
     }
+    let placed_at = if a.as_is {
+        String::new()
+    } else {
+        format!(", starting {:.2} m ahead", a.distance)
+    };
     eprintln!(
-        "{}: {} frames at {} fps, tag {} mm at {:.2} m",
+        "{}: {} frames at {} fps, tag {} mm{placed_at}",
         a.out.display(),
         frames.len(),
         a.fps,
         a.tag_size * 1000.0,
-        a.distance
     );
     Ok(())
 }
@@ -294,7 +352,8 @@ pub fn track(args: &RunArgs) -> Result<()> {
         ..DetectorSettings::default()
     };
     let detector = Detector::new(args.family, settings)?;
-    let mut tracker = Tracker::new(detector, args.tag_id, args.tag_size, k);
+    let mut tracker =
+        Tracker::new(detector, args.tag_id, args.tag_size, k).with_smoothing(!args.raw);
     let mut sink = Sink::open(args.out.as_deref())?;
     let mut overlay_done = args.overlay.is_none();
     let mut frames = 0u64;
@@ -433,9 +492,12 @@ pub fn overlay(
         ];
         for (axis, colour) in axes {
             // A figurine axis in the camera frame: through the figurine→tag flip.
-            let tip = t + r * (super::pose::FLIP_YZ * axis) * tag_size;
+            let tip = t + r * (super::pose::FLIP_YZ * axis) * tag_size * 1.5;
             if let (Some(a), Some(b)) = (origin, project(k, tip)) {
-                line(&mut img, pt(a), pt(b), colour);
+                let ((ax, ay), (bx, by)) = (pt(a), pt(b));
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1)] {
+                    line(&mut img, (ax + dx, ay + dy), (bx + dx, by + dy), colour);
+                }
             }
         }
     }

@@ -123,8 +123,20 @@ pub struct FrameTruth {
     pub pose: PoseSample,
     /// The figurine's speed, m/s.
     pub speed: f64,
-    /// Whether a finger covered part of the tag.
-    pub occluded: bool,
+    /// Whether the tag was out of sight: a finger covered part of it, or it was turned more
+    /// than [`MAX_VIEW_DEG`] from the camera (the back of a turn or spin).
+    pub hidden: bool,
+}
+
+/// A tag turned further than this from the camera (degrees between its normal and the line
+/// of sight) is out of sight: seen that edge-on, 4 cm is a sliver.
+pub const MAX_VIEW_DEG: f64 = 70.0;
+
+/// Angle between the figurine's front and the direction from it to the camera, degrees.
+pub fn facing_deg(pose: &PoseSample) -> f64 {
+    let front = quat(pose) * DVec3::Z;
+    let to_camera = -DVec3::from_array(pose.pos);
+    front.angle_between(to_camera).to_degrees()
 }
 
 /// The scene of `setup` with tag `id` of `family`.
@@ -174,7 +186,7 @@ pub fn render_video(
             t: tv,
             pose,
             speed: if speed.is_finite() { speed } else { 0.0 },
-            occluded: r.occluded,
+            hidden: r.occluded || facing_deg(&pose) > MAX_VIEW_DEG,
         });
     }
     out.finish()?;
@@ -187,11 +199,12 @@ pub fn track_video(
     family: Family,
     id: u32,
     path: &Path,
+    smooth: bool,
 ) -> Result<super::tracker::TrackRun, TrackError> {
     let mut reader = FrameReader::open(Source::File(path.to_path_buf()))?;
     let k = intrinsics_from_fov(reader.width(), reader.height(), setup.fov_deg);
     let detector = Detector::new(family, DetectorSettings::default())?;
-    let mut tracker = Tracker::new(detector, id, setup.tag_size, k);
+    let mut tracker = Tracker::new(detector, id, setup.tag_size, k).with_smoothing(smooth);
     track_reader(&mut reader, &mut tracker, |_| Ok(()))
 }
 
@@ -242,10 +255,10 @@ pub struct Summary {
     pub frames: usize,
     /// Frames without a sample.
     pub lost: usize,
-    /// Frames without a sample that no finger covered.
-    pub lost_clear: usize,
-    /// Frames a finger covered.
-    pub occluded: usize,
+    /// Frames without a sample where the tag was in sight.
+    pub lost_visible: usize,
+    /// Frames where the tag was out of sight ([`FrameTruth::hidden`]).
+    pub hidden: usize,
     /// Median position error, mm.
     pub pos_median_mm: f64,
     /// 90th percentile of position error, mm.
@@ -257,13 +270,13 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// Share of frames no finger covered that were lost.
-    pub fn lost_clear_share(&self) -> f64 {
-        let clear = self.frames - self.occluded;
+    /// Share of the frames with the tag in sight that were lost.
+    pub fn lost_visible_share(&self) -> f64 {
+        let clear = self.frames - self.hidden;
         if clear == 0 {
             0.0
         } else {
-            self.lost_clear as f64 / clear as f64
+            self.lost_visible as f64 / clear as f64
         }
     }
 }
@@ -283,7 +296,7 @@ pub fn summarize<'a>(frames: impl IntoIterator<Item = &'a FrameError>) -> Summar
     let (mut pos, mut ori) = (Vec::new(), Vec::new());
     for f in frames {
         s.frames += 1;
-        s.occluded += usize::from(f.truth.occluded);
+        s.hidden += usize::from(f.truth.hidden);
         match f.error {
             Some((p, o)) => {
                 pos.push(p);
@@ -291,7 +304,7 @@ pub fn summarize<'a>(frames: impl IntoIterator<Item = &'a FrameError>) -> Summar
             }
             None => {
                 s.lost += 1;
-                s.lost_clear += usize::from(!f.truth.occluded);
+                s.lost_visible += usize::from(!f.truth.hidden);
             }
         }
     }
@@ -409,7 +422,7 @@ mod tests {
             t: 0.0,
             pose: log(1).samples[0],
             speed: 0.0,
-            occluded: false,
+            hidden: false,
         };
         let frames = [
             FrameError {
@@ -431,18 +444,15 @@ mod tests {
                 tracked: None,
             },
             FrameError {
-                truth: FrameTruth {
-                    occluded: true,
-                    ..t
-                },
+                truth: FrameTruth { hidden: true, ..t },
                 error: None,
                 delta: None,
                 tracked: None,
             },
         ];
         let s = summarize(&frames);
-        assert_eq!((s.frames, s.lost, s.lost_clear, s.occluded), (4, 2, 1, 1));
-        assert!((s.lost_clear_share() - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!((s.frames, s.lost, s.lost_visible, s.hidden), (4, 2, 1, 1));
+        assert!((s.lost_visible_share() - 1.0 / 3.0).abs() < 1e-12);
         assert!(s.pos_median_mm == 1.0 || s.pos_median_mm == 3.0);
     }
 }

@@ -8,6 +8,7 @@
 //! a moving figurine and [`eval`] compares what was tracked with the truth.
 
 pub mod bench;
+pub mod calibrate;
 pub mod cli;
 pub mod detect;
 pub mod eval;
@@ -15,6 +16,7 @@ pub mod pnp;
 pub mod pose;
 pub mod print;
 pub mod render;
+pub mod smooth;
 pub mod tracker;
 pub mod video;
 

@@ -27,7 +27,7 @@ pub fn object_corners(size: f64) -> [DVec3; 4] {
 
 /// Solves a small dense linear system `a x = b` by Gaussian elimination with partial
 /// pivoting; `None` when singular.
-fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
+pub fn solve_linear<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
     for col in 0..N {
         let piv = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
         if a[piv][col].abs() < 1e-14 {
@@ -68,7 +68,7 @@ fn homography(plane: &[DVec3; 4], image: &[DVec2; 4]) -> Option<DMat3> {
         a[2 * i + 1] = [0.0, 0.0, 0.0, x, y, 1.0, -v * x, -v * y];
         b[2 * i + 1] = v;
     }
-    let h = solve(a, b)?;
+    let h = solve_linear(a, b)?;
     Some(DMat3::from_cols(
         DVec3::new(h[0], h[3], h[6]),
         DVec3::new(h[1], h[4], h[7]),
@@ -156,7 +156,7 @@ fn refine(
             for (a, row) in damped.iter_mut().enumerate() {
                 row[a] += mu * jtj[a][a].max(1e-9);
             }
-            let Some(d) = solve(damped, jtr) else {
+            let Some(d) = solve_linear(damped, jtr) else {
                 mu *= 10.0;
                 continue;
             };

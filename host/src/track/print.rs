@@ -30,7 +30,7 @@ pub fn caption(family: Family, id: u32, size_m: f64) -> [String; 2] {
             family.name(),
             size_m * 1000.0
         ),
-        "ON THE FIGURINE'S CHEST, THIS WAY UP".to_string(),
+        "ON THE CHEST OF THE FIGURINE, THIS WAY UP".to_string(),
     ]
 }
 

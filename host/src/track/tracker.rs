@@ -25,6 +25,7 @@ pub struct Tracker {
     intrinsics: Intrinsics,
     last: Option<DQuat>,
     last_cam: Option<DQuat>,
+    smooth: Option<super::smooth::OrientationFilter>,
 }
 
 /// What one frame gave.
@@ -49,7 +50,14 @@ impl Tracker {
             intrinsics,
             last: None,
             last_cam: None,
+            smooth: None,
         }
+    }
+
+    /// Smooths the orientation (see [`super::smooth`]); off by default.
+    pub fn with_smoothing(mut self, on: bool) -> Self {
+        self.smooth = on.then(super::smooth::OrientationFilter::default);
+        self
     }
 
     /// The camera's intrinsics in use.
@@ -78,6 +86,9 @@ impl Tracker {
             }
             self.last_cam = Some(pose.quat());
             let (p, mut q) = figurine_pose(pose);
+            if let Some(f) = &mut self.smooth {
+                q = f.push(t, q);
+            }
             if let Some(last) = self.last {
                 if q.dot(last) < 0.0 {
                     q = -q;
