@@ -55,7 +55,7 @@ enum Command {
     #[cfg(feature = "render")]
     View(render::cli::ViewArgs),
     /// Track a printed AprilTag in a video or a webcam: a pose log anyone can make
-    /// (`track print-tag`, `track render`, `track bench`).
+    /// (`track print-tag`, `track calibrate`, `track render`, `track bench`).
     Track(track::cli::TrackArgs),
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,

@@ -153,6 +153,21 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
     let (a, b) = (&tracked.samples[0], tracked.samples.last().unwrap());
     assert!(b.pos[0] - a.pos[0] > 0.12);
     assert!(image::open(&overlay).unwrap().width() == 640);
+    // `--out -`: the same log on stdout, a line per frame, for `figurine live`'s stdin.
+    let out = figurine(&["track", "--video", s(&video), "--out", "-"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let piped = PoseLog::read(&out.stdout[..], Path::new("stdout")).unwrap();
+    assert_eq!(piped.samples.len(), tracked.samples.len());
+    for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
+        assert!(
+            figurine_host::link::live::parse_pose_line(line).is_some(),
+            "{line}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -322,6 +337,7 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
         "--as-is",
         "--fov",
         "72",
+        "--clean",
     ]);
     assert!(
         out.status.success(),

@@ -329,12 +329,17 @@ pub struct Noise {
     pub pairs: usize,
 }
 
-/// Measures [`Noise`] over frames whose true speed is under 5 mm/s.
+/// Measures [`Noise`] over pairs of consecutive frames between which the figurine did not
+/// move (by under 0.01 mm and 0.01°: the generator's pauses).
 pub fn still_noise(frames: &[FrameError]) -> Noise {
     let (mut dx, mut dz, mut da) = (Vec::new(), Vec::new(), Vec::new());
     for w in frames.windows(2) {
         let (a, b) = (&w[0], &w[1]);
-        if a.truth.speed > 0.005 || b.truth.speed > 0.005 {
+        let moved = (DVec3::from_array(a.truth.pose.pos) - DVec3::from_array(b.truth.pose.pos))
+            .length()
+            > 1e-5
+            || angle_between_deg(quat(&a.truth.pose), quat(&b.truth.pose)) > 0.01;
+        if moved || (b.truth.t - a.truth.t) > 0.05 {
             continue;
         }
         if let (Some(ea), Some(eb)) = (a.delta, b.delta) {

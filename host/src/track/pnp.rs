@@ -8,10 +8,12 @@ use glam::{DMat3, DQuat, DVec2, DVec3};
 
 use super::detect::{CameraPose, Intrinsics};
 
-/// Two poses whose reprojection errors are within this factor (and [`TIE_PX`]) are a tie.
-const TIE_FACTOR: f64 = 1.5;
+/// Two poses whose reprojection errors are within this factor (and [`TIE_PX`]) are a tie:
+/// near face-on, sensor noise alone reorders them from frame to frame, and taking the lower
+/// one each time flips the tilt by degrees between still frames.
+const TIE_FACTOR: f64 = 3.0;
 /// Absolute slack of a tie, pixels RMS.
-const TIE_PX: f64 = 0.1;
+const TIE_PX: f64 = 0.3;
 
 /// The corners' positions on the tag plane (metres, tag frame: x right, y down as printed),
 /// in the detector's order: counter-clockwise in the image from the printed bottom-left.

@@ -208,7 +208,8 @@ impl Scene {
                 pose_at(t + dt).and_then(|p| PlaneView::new(&self.intrinsics, &p))
             })
             .collect();
-        if let Some(bbox) = self.bbox(&views, t, &pose_at) {
+        let bbox = self.bbox(&views, t, &pose_at);
+        if let Some(bbox) = bbox {
             let (x0, y0, x1, y1) = bbox;
             // 16 samples per pixel, 4 in each sub-exposure on grids shifted by a quarter
             // pixel: coarser sampling quantises an edge's place within its pixel enough to
@@ -258,14 +259,33 @@ impl Scene {
         let occluded = self.occlude(&mut img, t, &views);
         self.light(&mut img, t);
         if self.faults.defocus_px > 0.0 {
-            gaussian_blur(&mut img, w, h, self.faults.defocus_px);
+            // Only around the figurine: the room is smooth already, and blurring all of it
+            // would be most of a frame's time.
+            if let Some((x0, y0, x1, y1)) = bbox {
+                let pad = 8;
+                let (x0, y0) = (x0.saturating_sub(pad), y0.saturating_sub(pad));
+                let (x1, y1) = ((x1 + pad).min(w), (y1 + pad).min(h));
+                let (bw, bh) = (x1 - x0, y1 - y0);
+                let mut part: Vec<f64> = (y0..y1)
+                    .flat_map(|y| img[y * w + x0..y * w + x1].iter().copied())
+                    .collect();
+                gaussian_blur(&mut part, bw, bh, self.faults.defocus_px);
+                for (row, y) in (y0..y1).enumerate() {
+                    img[y * w + x0..y * w + x1].copy_from_slice(&part[row * bw..(row + 1) * bw]);
+                }
+            }
         }
         let mut rng = SynthRng::from_u64(self.seed.wrapping_mul(0x9e37) ^ index);
+        let sigma = self.faults.noise;
         let pixels = img
             .iter()
             .map(|&v| {
-                let n = if self.faults.noise > 0.0 {
-                    self.faults.noise * rng.normal()
+                // Irwin–Hall: four 16-bit uniforms from one draw make a near-normal variate
+                // (σ 1) without a logarithm per pixel.
+                let n = if sigma > 0.0 {
+                    let r = rng.next_u64();
+                    let sum: f64 = (0..4).map(|k| ((r >> (16 * k)) & 0xffff) as f64).sum();
+                    sigma * (sum / 65535.0 - 2.0) * 3f64.sqrt()
                 } else {
                     0.0
                 };
