@@ -37,6 +37,9 @@ pub struct BenchArgs {
     /// Track without smoothing the orientation (`figurine track --raw`).
     #[arg(long)]
     pub raw: bool,
+    /// Edge of the tag's black square, metres.
+    #[arg(long, default_value_t = 0.04)]
+    pub tag_size: f64,
 }
 
 /// One gesture tracked.
@@ -220,6 +223,12 @@ pub fn report(runs: &[GestureRun]) -> String {
 
 /// `figurine track bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
+    if !(args.tag_size > 0.0 && args.tag_size < 0.5) {
+        anyhow::bail!(
+            "--tag-size {}: the black square's edge in metres",
+            args.tag_size
+        );
+    }
     let tmp;
     let dir = match &args.keep {
         Some(d) => {
@@ -237,6 +246,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for (di, &distance) in args.distances.iter().enumerate() {
         let setup = Setup {
             distance,
+            tag_size: args.tag_size,
             seed: args.seed.wrapping_add(di as u64),
             ..Setup::default()
         };
