@@ -401,53 +401,53 @@ pub fn track(args: &RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// Where samples go: a file written at the end, or stdout a line at a time.
-enum Sink {
-    File(PathBuf, PoseLog),
-    Stdout(std::io::Stdout),
-    None,
+/// Where samples go: a file or stdout, a line per sample as it is made and flushed, so a
+/// camera session ended with Ctrl-C keeps every sample and `live` reading the pipe gets each
+/// pose at once.
+struct Sink {
+    out: Option<(String, Box<dyn Write>)>,
 }
 
 impl Sink {
     fn open(out: Option<&Path>) -> Result<Self> {
-        Ok(match out {
-            Some(p) if p == Path::new("-") => {
-                let mut so = std::io::stdout();
-                writeln!(so, "{}", HEADER.join(",")).context("writing to stdout")?;
-                so.flush().context("writing to stdout")?;
-                Sink::Stdout(so)
-            }
+        let (name, mut w): (String, Box<dyn Write>) = match out {
+            None => return Ok(Sink { out: None }),
+            Some(p) if p == Path::new("-") => ("stdout".into(), Box::new(std::io::stdout())),
             Some(p) => {
                 // Fails now, not after the whole video, when the file cannot be made.
-                std::fs::File::create(p).map_err(|source| TrackError::Write {
+                let f = std::fs::File::create(p).map_err(|source| TrackError::Write {
                     path: p.to_path_buf(),
                     source,
                 })?;
-                Sink::File(p.to_path_buf(), PoseLog::default())
+                (
+                    p.display().to_string(),
+                    Box::new(std::io::BufWriter::new(f)),
+                )
             }
-            None => Sink::None,
+        };
+        writeln!(w, "{}", HEADER.join(",")).with_context(|| format!("writing {name}"))?;
+        w.flush().with_context(|| format!("writing {name}"))?;
+        Ok(Sink {
+            out: Some((name, w)),
         })
     }
 
     fn push(&mut self, s: &PoseSample) -> Result<()> {
-        match self {
-            Sink::File(_, log) => log.samples.push(*s),
-            Sink::Stdout(so) => {
-                let mut one = Vec::new();
-                PoseLog { samples: vec![*s] }.write(&mut one)?;
-                // Skip the header line `write` puts first.
-                let line = one.splitn(2, |&b| b == b'\n').nth(1).unwrap_or(&[]);
-                so.write_all(line).context("writing to stdout")?;
-                so.flush().context("writing to stdout")?;
-            }
-            Sink::None => {}
-        }
-        Ok(())
+        let Some((name, w)) = &mut self.out else {
+            return Ok(());
+        };
+        let mut one = Vec::new();
+        PoseLog { samples: vec![*s] }.write(&mut one)?;
+        // `write` puts a header first: keep only the sample's line.
+        let line = one.splitn(2, |&b| b == b'\n').nth(1).unwrap_or(&[]);
+        w.write_all(line)
+            .with_context(|| format!("writing {name}"))?;
+        w.flush().with_context(|| format!("writing {name}"))
     }
 
     fn finish(self) -> Result<()> {
-        if let Sink::File(path, log) = self {
-            log.write_path(&path)?;
+        if let Some((name, mut w)) = self.out {
+            w.flush().with_context(|| format!("writing {name}"))?;
         }
         Ok(())
     }
