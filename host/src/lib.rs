@@ -14,3 +14,4 @@ pub mod raster;
 pub mod recognize;
 pub mod render;
 pub mod synth;
+pub mod track;

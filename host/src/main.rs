@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 #[cfg(feature = "render")]
 use figurine_host::render;
-use figurine_host::{anim, graph, link, recognize, synth};
+use figurine_host::{anim, graph, link, recognize, synth, track};
 
 /// figurine: play with a toy, get a character animation.
 #[derive(Parser, Debug)]
@@ -54,6 +54,9 @@ enum Command {
     /// Show an animation in a window: orbit camera, play/pause/scrub/speed.
     #[cfg(feature = "render")]
     View(render::cli::ViewArgs),
+    /// Track a printed AprilTag in a video or a webcam: a pose log anyone can make
+    /// (`track print-tag`, `track calibrate`, `track render`, `track bench`).
+    Track(track::cli::TrackArgs),
     /// Print the wire-protocol version this host speaks.
     ProtocolVersion,
 }
@@ -78,6 +81,7 @@ fn main() -> anyhow::Result<()> {
         Command::Check(a) => anim::check::run(&a)?,
         Command::Clip(a) => anim::cli::run_clip(&a)?,
         Command::Graph(a) => graph::cli::run(a)?,
+        Command::Track(a) => track::cli::run(&a)?,
         #[cfg(feature = "render")]
         Command::Render(a) => render::cli::run_render(&a)?,
         #[cfg(feature = "render")]

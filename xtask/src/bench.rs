@@ -71,6 +71,12 @@ pub fn bench() -> Result<()> {
     );
     figurine(&["check", "--reference", "--defaults"])?;
 
+    step(
+        "webcam tracker against the truth (rendered doodles, 640x480, 4 cm tag at 0.5-1 m): \
+         figurine track bench",
+    );
+    figurine(&["track", "bench"])?;
+
     step("firmware: sizes, instructions per sample, latency, sustained rate");
     if !crate::util::have("defmt-print") {
         // The mean instructions per sample come from the firmware's defmt log.

@@ -1,0 +1,276 @@
+//! `figurine track bench`: the tracker against the truth. Generated gestures (every action in
+//! turn, random effort) are placed in front of the camera at each distance, rendered with the
+//! webcam's faults, encoded to MP4, decoded and tracked; the report gives position and
+//! orientation error by distance and by speed, frames lost, the time per frame, whether the
+//! recognizer reads the same actions from the tracked log as from the true one, and the
+//! tracked log's jitter at rest.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::detect::Family;
+use super::eval::{
+    compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
+    FrameError, Noise, Setup, Summary,
+};
+use crate::recognize::simulate::{load_effort, load_library, simulate_log};
+use crate::synth::{gesture, Action, Effort, Knobs, Range};
+
+/// Arguments of `figurine track bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Distances from the camera to each gesture's start, metres.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.5, 0.75, 1.0])]
+    pub distances: Vec<f64>,
+    /// Gestures per distance (actions in turn: walk, run, jump, …).
+    #[arg(long, default_value_t = 12)]
+    pub gestures: usize,
+    /// Master seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Keep the videos and logs here (default: a temporary folder, removed).
+    #[arg(long)]
+    pub keep: Option<PathBuf>,
+    /// Track without smoothing the orientation (`figurine track --raw`).
+    #[arg(long)]
+    pub raw: bool,
+    /// Edge of the tag's black square, metres.
+    #[arg(long, default_value_t = 0.04)]
+    pub tag_size: f64,
+}
+
+/// One gesture tracked.
+#[derive(Debug, Clone)]
+pub struct GestureRun {
+    /// The action performed.
+    pub action: Action,
+    /// Distance it started at, metres.
+    pub distance: f64,
+    /// Every frame compared.
+    pub frames: Vec<FrameError>,
+    /// Actions the recognizer read from the truth at the camera's frame times.
+    pub truth_actions: Vec<String>,
+    /// Actions it read from the tracked log.
+    pub tracked_actions: Vec<String>,
+    /// Tracking time per frame (detection and pose), seconds.
+    pub latency_s: Vec<f64>,
+}
+
+/// The generator's knobs for tracked gestures: clean truth at 240 Hz (the renderer blurs
+/// between samples), small enough to stay in view at half a metre, a toy held a little
+/// crooked.
+pub fn knobs() -> Knobs {
+    Knobs {
+        scale: Range::new(0.4, 0.7),
+        speed: Range::new(0.8, 1.25),
+        tilt_deg: Range::new(0.0, 10.0),
+        rate_hz: Range::fixed(240.0),
+        ..Knobs::canonical()
+    }
+}
+
+/// Renders, tracks and compares one gesture; files go in `dir`.
+pub fn run_gesture(
+    setup: &Setup,
+    action: Action,
+    seed: u64,
+    dir: &std::path::Path,
+    smooth: bool,
+) -> Result<GestureRun> {
+    let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
+    let effort = Effort::random_state(&mut pick);
+    let doodle = gesture(seed, &knobs(), action, effort);
+    let placed = place(&doodle.log, setup.distance);
+    let sc = scene(setup, Family::Tag36h11, 0)?;
+    let video = dir.join(format!("{}-{seed}.mp4", action.name()));
+    let truths = render_video(setup, &sc, &placed, &video)?;
+    let run = track_video(setup, Family::Tag36h11, 0, &video, smooth)?;
+    let frames = compare(&truths, &run.log);
+    let (lib, blob) = load_library(None)?;
+    let effort_model = load_effort(None)?;
+    let names = lib.names();
+    let read = |log: &crate::poselog::PoseLog| -> Result<Vec<String>> {
+        Ok(simulate_log(log, &names, &blob, Some(effort_model))?
+            .records
+            .into_iter()
+            .map(|r| r.action)
+            .collect())
+    };
+    let truth = truth_log(&truths);
+    let truth_actions = read(&truth)?;
+    let tracked_actions = read(&run.log)?;
+    if dir.join("keep").exists() {
+        truth.write_path(&video.with_extension("truth.csv"))?;
+        run.log.write_path(&video.with_extension("tracked.csv"))?;
+    }
+    Ok(GestureRun {
+        action,
+        distance: setup.distance,
+        frames,
+        truth_actions,
+        tracked_actions,
+        latency_s: run.latency_s,
+    })
+}
+
+fn row(out: &mut String, label: &str, s: &Summary) {
+    let _ = writeln!(
+        out,
+        "| {label} | {} | {:.1} % ({:.1} % of frames in sight) | {:.1} / {:.1} | {:.2} / {:.2} |",
+        s.frames,
+        100.0 * s.lost as f64 / s.frames.max(1) as f64,
+        100.0 * s.lost_visible_share(),
+        s.pos_median_mm,
+        s.pos_p90_mm,
+        s.ori_median_deg,
+        s.ori_p90_deg
+    );
+}
+
+/// The report's tables for a set of tracked gestures.
+pub fn report(runs: &[GestureRun]) -> String {
+    let mut out = String::new();
+    let all: Vec<&FrameError> = runs.iter().flat_map(|r| &r.frames).collect();
+    let head = "| frames | lost | position error median / p90, mm | orientation error median / p90, ° |\n|---|---|---|---|---|";
+    let _ = writeln!(out, "by distance from the camera (m)\n| distance {head}");
+    for (lo, hi) in [(0.2, 0.5), (0.5, 0.75), (0.75, 1.0), (1.0, 1.5)] {
+        let s = summarize(all.iter().copied().filter(|f| {
+            let d = -f.truth.pose.pos[2];
+            d >= lo && d < hi
+        }));
+        if s.frames > 0 {
+            row(&mut out, &format!("{lo:.2}–{hi:.2}"), &s);
+        }
+    }
+    let _ = writeln!(out, "\nby speed (m/s)\n| speed {head}");
+    for (lo, hi) in [
+        (0.0, 0.05),
+        (0.05, 0.25),
+        (0.25, 0.5),
+        (0.5, 1.0),
+        (1.0, 9.0),
+    ] {
+        let s = summarize(
+            all.iter()
+                .copied()
+                .filter(|f| f.truth.speed >= lo && f.truth.speed < hi),
+        );
+        if s.frames > 0 {
+            row(&mut out, &format!("{lo:.2}–{hi:.2}"), &s);
+        }
+    }
+    let s = summarize(all.iter().copied());
+    let _ = writeln!(out, "\nall\n| all {head}");
+    row(&mut out, "all", &s);
+    let same = runs
+        .iter()
+        .filter(|r| r.truth_actions == r.tracked_actions)
+        .count();
+    let _ = writeln!(
+        out,
+        "\nrecognized actions: the same from the tracked log as from the true one in {same} of \
+         {} gestures ({:.1} %)",
+        runs.len(),
+        100.0 * same as f64 / runs.len().max(1) as f64
+    );
+    for r in runs.iter().filter(|r| r.truth_actions != r.tracked_actions) {
+        let _ = writeln!(
+            out,
+            "  {} at {:.2} m: truth {:?}, tracked {:?}",
+            r.action.name(),
+            r.distance,
+            r.truth_actions,
+            r.tracked_actions
+        );
+    }
+    let mut lat: Vec<f64> = runs.iter().flat_map(|r| r.latency_s.clone()).collect();
+    let (med, p95) = (quantile(&mut lat, 0.5), quantile(&mut lat, 0.95));
+    let _ = writeln!(
+        out,
+        "\nframe → sample (detection and pose, 640×480): median {:.1} ms, p95 {:.1} ms",
+        med * 1000.0,
+        p95 * 1000.0
+    );
+    let _ = writeln!(out, "\ntracked jitter at rest (σ):");
+    for (lo, hi) in [(0.2, 0.65), (0.65, 0.9), (0.9, 1.5)] {
+        let frames: Vec<FrameError> = runs
+            .iter()
+            .flat_map(|r| r.frames.iter().copied())
+            .filter(|f| {
+                let d = -f.truth.pose.pos[2];
+                d >= lo && d < hi
+            })
+            .collect();
+        let Noise {
+            across_mm,
+            depth_mm,
+            ori_deg,
+            pairs,
+        } = still_noise(&frames);
+        if pairs > 0 {
+            let _ = writeln!(
+                out,
+                "  {lo:.2}–{hi:.2} m: across {across_mm:.2} mm, depth {depth_mm:.2} mm, \
+                 orientation {ori_deg:.3}° ({pairs} still frame pairs)"
+            );
+        }
+    }
+    out
+}
+
+/// `figurine track bench`.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    if !(args.tag_size > 0.0 && args.tag_size < 0.5) {
+        anyhow::bail!(
+            "--tag-size {}: the black square's edge in metres",
+            args.tag_size
+        );
+    }
+    let tmp;
+    let dir = match &args.keep {
+        Some(d) => {
+            std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+            std::fs::write(d.join("keep"), b"").ok();
+            d.clone()
+        }
+        None => {
+            tmp = std::env::temp_dir().join(format!("figurine-track-bench-{}", std::process::id()));
+            std::fs::create_dir_all(&tmp)?;
+            tmp.clone()
+        }
+    };
+    let mut runs = Vec::new();
+    for (di, &distance) in args.distances.iter().enumerate() {
+        let setup = Setup {
+            distance,
+            tag_size: args.tag_size,
+            seed: args.seed.wrapping_add(di as u64),
+            ..Setup::default()
+        };
+        for g in 0..args.gestures {
+            let action = Action::ALL[g % Action::ALL.len()];
+            let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
+            let r = run_gesture(&setup, action, seed, &dir, !args.raw)?;
+            let s = summarize(&r.frames);
+            eprintln!(
+                "{:>9} at {distance:.2} m: {} frames, {:.1} % lost, {:.1} mm, {:.2}°, truth {:?}, tracked {:?}",
+                action.name(),
+                s.frames,
+                100.0 * s.lost as f64 / s.frames.max(1) as f64,
+                s.pos_median_mm,
+                s.ori_median_deg,
+                r.truth_actions,
+                r.tracked_actions
+            );
+            runs.push(r);
+        }
+    }
+    print!("{}", report(&runs));
+    if args.keep.is_none() {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Ok(())
+}

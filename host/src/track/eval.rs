@@ -1,0 +1,463 @@
+//! The tracker against the truth: doodles from the project's generator are placed in front of
+//! a camera, rendered ([`super::render`]), encoded to MP4, decoded and tracked, and every frame
+//! is compared with the pose that was drawn — position error (mm), orientation error (°),
+//! frames lost — binned by distance and speed; the recognizer reads both logs and the
+//! actions are compared.
+
+use std::path::Path;
+
+use glam::{DQuat, DVec3};
+
+use super::detect::{tag_pattern, Detector, DetectorSettings, Family};
+use super::pose::{angle_between_deg, intrinsics_from_fov};
+use super::render::{Faults, Scene};
+use super::tracker::{track_reader, Tracker};
+use super::video::{FrameReader, Mp4Writer, Source};
+use super::TrackError;
+use crate::poselog::{PoseLog, PoseSample};
+
+/// How the test videos are made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setup {
+    /// Frame width, pixels.
+    pub width: usize,
+    /// Frame height, pixels.
+    pub height: usize,
+    /// Horizontal field of view, degrees.
+    pub fov_deg: f64,
+    /// Frames per second.
+    pub fps: f64,
+    /// Edge of the tag's black square, metres.
+    pub tag_size: f64,
+    /// Distance from the camera to the doodle's first pose, metres.
+    pub distance: f64,
+    /// The webcam's faults.
+    pub faults: Faults,
+    /// Seed of the picture's noise, light and occlusion.
+    pub seed: u64,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            fov_deg: 60.0,
+            fps: 30.0,
+            tag_size: 0.04,
+            distance: 0.7,
+            faults: Faults::default(),
+            seed: 0,
+        }
+    }
+}
+
+fn quat(s: &PoseSample) -> DQuat {
+    DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize()
+}
+
+/// Moves a doodle in front of the camera: its first pose `distance` metres straight ahead,
+/// turned about the vertical so that its first front faces the camera (the tag in view).
+pub fn place(log: &PoseLog, distance: f64) -> PoseLog {
+    let Some(first) = log.samples.first() else {
+        return log.clone();
+    };
+    let front = quat(first) * DVec3::Z;
+    let yaw = front.x.atan2(front.z);
+    let turn = DQuat::from_rotation_y(-yaw);
+    let p0 = DVec3::from_array(first.pos);
+    let target = DVec3::new(0.0, 0.0, -distance);
+    PoseLog {
+        samples: log
+            .samples
+            .iter()
+            .map(|s| {
+                let p = turn * (DVec3::from_array(s.pos) - p0) + target;
+                let q = turn * quat(s);
+                PoseSample {
+                    t: s.t,
+                    pos: p.to_array(),
+                    quat: [q.w, q.x, q.y, q.z],
+                }
+            })
+            .collect(),
+    }
+}
+
+/// The pose at `t`, interpolated between the log's samples (linear, spherical); `None`
+/// outside the log.
+pub fn pose_at(log: &PoseLog, t: f64) -> Option<PoseSample> {
+    let s = &log.samples;
+    let i = s.partition_point(|p| p.t <= t);
+    if i == 0 || (i == s.len() && s.last()?.t < t) {
+        return (s.first()?.t == t).then(|| s[0]);
+    }
+    if i == s.len() {
+        return s.last().copied();
+    }
+    let (a, b) = (&s[i - 1], &s[i]);
+    let f = if b.t > a.t {
+        (t - a.t) / (b.t - a.t)
+    } else {
+        0.0
+    };
+    let p = DVec3::from_array(a.pos).lerp(DVec3::from_array(b.pos), f);
+    let (qa, mut qb) = (quat(a), quat(b));
+    if qa.dot(qb) < 0.0 {
+        qb = -qb;
+    }
+    let q = qa.slerp(qb, f);
+    Some(PoseSample {
+        t,
+        pos: p.to_array(),
+        quat: [q.w, q.x, q.y, q.z],
+    })
+}
+
+/// What one rendered frame showed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameTruth {
+    /// Frame time on the video's clock (the log's clock minus its first sample's), seconds.
+    pub t: f64,
+    /// The figurine's true pose (time on the log's clock).
+    pub pose: PoseSample,
+    /// The figurine's speed, m/s.
+    pub speed: f64,
+    /// Whether the tag was out of sight: a finger covered part of it, or it was turned more
+    /// than [`MAX_VIEW_DEG`] from the camera (the back of a turn or spin).
+    pub hidden: bool,
+}
+
+/// A tag turned further than this from the camera (degrees between its normal and the line
+/// of sight) is out of sight: seen that edge-on, 4 cm is a sliver.
+pub const MAX_VIEW_DEG: f64 = 70.0;
+
+/// Angle between the figurine's front and the direction from it to the camera, degrees.
+pub fn facing_deg(pose: &PoseSample) -> f64 {
+    let front = quat(pose) * DVec3::Z;
+    let to_camera = -DVec3::from_array(pose.pos);
+    front.angle_between(to_camera).to_degrees()
+}
+
+/// The scene of `setup` with tag `id` of `family`.
+pub fn scene(setup: &Setup, family: Family, id: u32) -> Result<Scene, TrackError> {
+    Ok(Scene {
+        width: setup.width,
+        height: setup.height,
+        intrinsics: intrinsics_from_fov(setup.width, setup.height, setup.fov_deg),
+        tag: tag_pattern(family, id)?,
+        tag_size: setup.tag_size,
+        faults: setup.faults,
+        seed: setup.seed,
+    })
+}
+
+/// Renders a placed log to an MP4 at `setup.fps`, one frame per period from its first to its
+/// last sample, and returns what each frame showed.
+pub fn render_video(
+    setup: &Setup,
+    scene: &Scene,
+    truth: &PoseLog,
+    path: &Path,
+) -> Result<Vec<FrameTruth>, TrackError> {
+    let (Some(first), Some(last)) = (truth.samples.first(), truth.samples.last()) else {
+        return Err(TrackError::BadArgument("the pose log is empty".into()));
+    };
+    let (t0, t1) = (first.t, last.t);
+    let frames = ((t1 - t0) * setup.fps).floor() as u64 + 1;
+    let background = scene.background();
+    let mut out = Mp4Writer::create(path, setup.width, setup.height, setup.fps)?;
+    let mut truths = Vec::with_capacity(frames as usize);
+    let at = |t: f64| pose_at(truth, t.clamp(t0, t1));
+    for i in 0..frames {
+        let tv = i as f64 / setup.fps;
+        let t = t0 + tv;
+        let Some(pose) = at(t) else { continue };
+        let r = scene.render(&background, i, t, at);
+        out.push(&r.frame)?;
+        let h = 0.005;
+        let speed = match (at(t - h), at(t + h)) {
+            (Some(a), Some(b)) => {
+                (DVec3::from_array(b.pos) - DVec3::from_array(a.pos)).length() / (b.t - a.t)
+            }
+            _ => 0.0,
+        };
+        truths.push(FrameTruth {
+            t: tv,
+            pose,
+            speed: if speed.is_finite() { speed } else { 0.0 },
+            hidden: r.occluded || facing_deg(&pose) > MAX_VIEW_DEG,
+        });
+    }
+    out.finish()?;
+    Ok(truths)
+}
+
+/// Tracks a video file with the setup's camera (its field of view known exactly).
+pub fn track_video(
+    setup: &Setup,
+    family: Family,
+    id: u32,
+    path: &Path,
+    smooth: bool,
+) -> Result<super::tracker::TrackRun, TrackError> {
+    let mut reader = FrameReader::open(Source::File(path.to_path_buf()))?;
+    let k = intrinsics_from_fov(reader.width(), reader.height(), setup.fov_deg);
+    let detector = Detector::new(family, DetectorSettings::default())?;
+    let mut tracker = Tracker::new(detector, id, setup.tag_size, k).with_smoothing(smooth);
+    track_reader(&mut reader, &mut tracker, |_| Ok(()))
+}
+
+/// One frame compared.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameError {
+    /// What was drawn.
+    pub truth: FrameTruth,
+    /// Position error, mm, and orientation error, degrees; `None` for a lost frame.
+    pub error: Option<(f64, f64)>,
+    /// Error vector tracked − true, metres, in world axes (x across, y up, z depth).
+    pub delta: Option<DVec3>,
+    /// The tracked sample.
+    pub tracked: Option<PoseSample>,
+}
+
+/// Pairs each rendered frame with the sample tracked at its time.
+pub fn compare(truth: &[FrameTruth], tracked: &PoseLog) -> Vec<FrameError> {
+    truth
+        .iter()
+        .map(|f| {
+            let found = tracked
+                .samples
+                .iter()
+                .find(|s| (s.t - f.t).abs() < 1e-6)
+                .copied();
+            let delta = found.map(|s| DVec3::from_array(s.pos) - DVec3::from_array(f.pose.pos));
+            let error = found.map(|s| {
+                (
+                    (DVec3::from_array(s.pos) - DVec3::from_array(f.pose.pos)).length() * 1000.0,
+                    angle_between_deg(quat(&s), quat(&f.pose)),
+                )
+            });
+            FrameError {
+                truth: *f,
+                error,
+                delta,
+                tracked: found,
+            }
+        })
+        .collect()
+}
+
+/// Errors over a set of frames.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Summary {
+    /// Frames.
+    pub frames: usize,
+    /// Frames without a sample.
+    pub lost: usize,
+    /// Frames without a sample where the tag was in sight.
+    pub lost_visible: usize,
+    /// Frames where the tag was out of sight ([`FrameTruth::hidden`]).
+    pub hidden: usize,
+    /// Median position error, mm.
+    pub pos_median_mm: f64,
+    /// 90th percentile of position error, mm.
+    pub pos_p90_mm: f64,
+    /// Median orientation error, degrees.
+    pub ori_median_deg: f64,
+    /// 90th percentile of orientation error, degrees.
+    pub ori_p90_deg: f64,
+}
+
+impl Summary {
+    /// Share of the frames with the tag in sight that were lost.
+    pub fn lost_visible_share(&self) -> f64 {
+        let clear = self.frames - self.hidden;
+        if clear == 0 {
+            0.0
+        } else {
+            self.lost_visible as f64 / clear as f64
+        }
+    }
+}
+
+/// The `q` quantile of `v` (sorted in place); NaN when empty.
+pub fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// Summarises the frames that `keep` selects.
+pub fn summarize<'a>(frames: impl IntoIterator<Item = &'a FrameError>) -> Summary {
+    let mut s = Summary::default();
+    let (mut pos, mut ori) = (Vec::new(), Vec::new());
+    for f in frames {
+        s.frames += 1;
+        s.hidden += usize::from(f.truth.hidden);
+        match f.error {
+            Some((p, o)) => {
+                pos.push(p);
+                ori.push(o);
+            }
+            None => {
+                s.lost += 1;
+                s.lost_visible += usize::from(!f.truth.hidden);
+            }
+        }
+    }
+    s.pos_median_mm = quantile(&mut pos, 0.5);
+    s.pos_p90_mm = quantile(&mut pos, 0.9);
+    s.ori_median_deg = quantile(&mut ori, 0.5);
+    s.ori_p90_deg = quantile(&mut ori, 0.9);
+    s
+}
+
+/// Jitter of the tracked pose where the figurine is still: σ of the frame-to-frame change
+/// of the error over consecutive still frames, /√2 (a slow bias cancels out).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Noise {
+    /// Position σ across the view (mean of x and y), mm.
+    pub across_mm: f64,
+    /// Position σ in depth (z), mm.
+    pub depth_mm: f64,
+    /// Orientation σ, degrees.
+    pub ori_deg: f64,
+    /// Still frame pairs measured.
+    pub pairs: usize,
+}
+
+/// Measures [`Noise`] over pairs of consecutive frames between which the figurine did not
+/// move (by under 0.01 mm and 0.01°: the generator's pauses).
+pub fn still_noise(frames: &[FrameError]) -> Noise {
+    let (mut dx, mut dz, mut da) = (Vec::new(), Vec::new(), Vec::new());
+    for w in frames.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let moved = (DVec3::from_array(a.truth.pose.pos) - DVec3::from_array(b.truth.pose.pos))
+            .length()
+            > 1e-5
+            || angle_between_deg(quat(&a.truth.pose), quat(&b.truth.pose)) > 0.01;
+        if moved || (b.truth.t - a.truth.t) > 0.05 {
+            continue;
+        }
+        if let (Some(ea), Some(eb)) = (a.delta, b.delta) {
+            let d = eb - ea;
+            dx.push(d.x);
+            dx.push(d.y);
+            dz.push(d.z);
+        }
+        if let (Some(sa), Some(sb)) = (a.tracked, b.tracked) {
+            // The truth does not turn between still frames: all the turn is jitter.
+            da.push(angle_between_deg(quat(&sa), quat(&sb)));
+        }
+    }
+    let rms = |v: &[f64]| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+        }
+    };
+    Noise {
+        across_mm: rms(&dx) / 2f64.sqrt() * 1000.0,
+        depth_mm: rms(&dz) / 2f64.sqrt() * 1000.0,
+        ori_deg: rms(&da) / 2f64.sqrt(),
+        pairs: dz.len(),
+    }
+}
+
+/// The truth at the camera's frame times, as a pose log on the video's clock (what a perfect
+/// tracker would have written), for reading the actions from.
+pub fn truth_log(frames: &[FrameTruth]) -> PoseLog {
+    PoseLog {
+        samples: frames
+            .iter()
+            .map(|f| PoseSample { t: f.t, ..f.pose })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn log(n: usize) -> PoseLog {
+        PoseLog {
+            samples: (0..n)
+                .map(|i| {
+                    let q = DQuat::from_rotation_y(0.1 * i as f64);
+                    PoseSample {
+                        t: i as f64 * 0.1,
+                        pos: [1.0 + i as f64, 2.0, 3.0],
+                        quat: [q.w, q.x, q.y, q.z],
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn interpolation_is_exact_at_samples_and_between() {
+        let l = log(5);
+        let p = pose_at(&l, 0.2).unwrap();
+        assert!((p.pos[0] - 3.0).abs() < 1e-9);
+        let m = pose_at(&l, 0.25).unwrap();
+        assert!((m.pos[0] - 3.5).abs() < 1e-9);
+        let expect = DQuat::from_rotation_y(0.25);
+        assert!(angle_between_deg(quat(&m), expect) < 1e-6);
+        assert!(pose_at(&l, -1.0).is_none() && pose_at(&l, 9.0).is_none());
+    }
+
+    #[test]
+    fn placing_puts_the_first_pose_ahead_facing_the_camera() {
+        let placed = place(&log(4), 0.8);
+        let first = &placed.samples[0];
+        assert!((DVec3::from_array(first.pos) - DVec3::new(0.0, 0.0, -0.8)).length() < 1e-9);
+        assert!((quat(first) * DVec3::Z - DVec3::Z).length() < 1e-9);
+        // The path keeps its shape: consecutive steps are still 1 m long.
+        let step = DVec3::from_array(placed.samples[1].pos) - DVec3::from_array(first.pos);
+        assert!((step.length() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn summaries_count_lost_frames_and_take_medians() {
+        let t = FrameTruth {
+            t: 0.0,
+            pose: log(1).samples[0],
+            speed: 0.0,
+            hidden: false,
+        };
+        let frames = [
+            FrameError {
+                truth: t,
+                error: Some((1.0, 0.5)),
+                delta: None,
+                tracked: None,
+            },
+            FrameError {
+                truth: t,
+                error: Some((3.0, 1.5)),
+                delta: None,
+                tracked: None,
+            },
+            FrameError {
+                truth: t,
+                error: None,
+                delta: None,
+                tracked: None,
+            },
+            FrameError {
+                truth: FrameTruth { hidden: true, ..t },
+                error: None,
+                delta: None,
+                tracked: None,
+            },
+        ];
+        let s = summarize(&frames);
+        assert_eq!((s.frames, s.lost, s.lost_visible, s.hidden), (4, 2, 1, 1));
+        assert!((s.lost_visible_share() - 1.0 / 3.0).abs() < 1e-12);
+        assert!(s.pos_median_mm == 1.0 || s.pos_median_mm == 3.0);
+    }
+}

@@ -1,0 +1,285 @@
+//! The tag's pose from its four corners: a homography from the tag's plane to the image,
+//! decomposed into a first pose, then refined (Levenberg–Marquardt on the 8 reprojection
+//! residuals). A flat square seen from afar has two poses that explain its corners almost
+//! equally — tilted toward or away from the line of sight — so both are refined, and a near
+//! tie goes to the one nearer the previous frame's orientation.
+
+use glam::{DMat3, DQuat, DVec2, DVec3};
+
+use super::detect::{CameraPose, Intrinsics};
+
+/// Two poses whose reprojection errors are within this factor (and [`TIE_PX`]) are a tie:
+/// near face-on, sensor noise alone reorders them from frame to frame, and taking the lower
+/// one each time flips the tilt by degrees between still frames.
+const TIE_FACTOR: f64 = 3.0;
+/// Absolute slack of a tie, pixels RMS.
+const TIE_PX: f64 = 0.3;
+
+/// The corners' positions on the tag plane (metres, tag frame: x right, y down as printed),
+/// in the detector's order: counter-clockwise in the image from the printed bottom-left.
+pub fn object_corners(size: f64) -> [DVec3; 4] {
+    let s = size / 2.0;
+    [
+        DVec3::new(-s, s, 0.0),
+        DVec3::new(s, s, 0.0),
+        DVec3::new(s, -s, 0.0),
+        DVec3::new(-s, -s, 0.0),
+    ]
+}
+
+/// Solves a small dense linear system `a x = b` by Gaussian elimination with partial
+/// pivoting; `None` when singular.
+pub fn solve_linear<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
+    for col in 0..N {
+        let piv = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() < 1e-14 {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        let pivot_row = a[col];
+        for row in col + 1..N {
+            let f = a[row][col] / pivot_row[col];
+            for (v, p) in a[row][col..].iter_mut().zip(&pivot_row[col..]) {
+                *v -= f * p;
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; N];
+    for row in (0..N).rev() {
+        let mut s = b[row];
+        for k in row + 1..N {
+            s -= a[row][k] * x[k];
+        }
+        x[row] = s / a[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// The homography taking plane points (x, y, 1) to normalised image points, from four
+/// correspondences.
+fn homography(plane: &[DVec3; 4], image: &[DVec2; 4]) -> Option<DMat3> {
+    let mut a = [[0.0; 8]; 8];
+    let mut b = [0.0; 8];
+    for i in 0..4 {
+        let (x, y) = (plane[i].x, plane[i].y);
+        let (u, v) = (image[i].x, image[i].y);
+        a[2 * i] = [x, y, 1.0, 0.0, 0.0, 0.0, -u * x, -u * y];
+        b[2 * i] = u;
+        a[2 * i + 1] = [0.0, 0.0, 0.0, x, y, 1.0, -v * x, -v * y];
+        b[2 * i + 1] = v;
+    }
+    let h = solve_linear(a, b)?;
+    Some(DMat3::from_cols(
+        DVec3::new(h[0], h[3], h[6]),
+        DVec3::new(h[1], h[4], h[7]),
+        DVec3::new(h[2], h[5], 1.0),
+    ))
+}
+
+/// A rotation and translation from a plane homography `H = λ [r1 r2 t]`.
+fn pose_from_homography(h: DMat3) -> Option<(DQuat, DVec3)> {
+    let scale = 2.0 / (h.x_axis.length() + h.y_axis.length());
+    // The tag is in front of the camera: t.z > 0 fixes λ's sign.
+    let sign = if h.z_axis.z < 0.0 { -1.0 } else { 1.0 };
+    let (r1, r2, t) = (
+        h.x_axis * scale * sign,
+        h.y_axis * scale * sign,
+        h.z_axis * scale * sign,
+    );
+    let r1n = r1.try_normalize()?;
+    let r2n = (r2 - r1n * r1n.dot(r2)).try_normalize()?;
+    let r = DMat3::from_cols(r1n, r2n, r1n.cross(r2n));
+    Some((DQuat::from_mat3(&r).normalize(), t))
+}
+
+/// Reprojection residuals (pixels) of the corners under pose (q, t).
+fn residuals(q: DQuat, t: DVec3, obj: &[DVec3; 4], px: &[DVec2; 4], k: &Intrinsics) -> [f64; 8] {
+    let mut r = [0.0; 8];
+    for i in 0..4 {
+        let p = q * obj[i] + t;
+        let z = p.z.max(1e-6);
+        r[2 * i] = k.cx + k.fx * p.x / z - px[i].x;
+        r[2 * i + 1] = k.cy + k.fy * p.y / z - px[i].y;
+    }
+    r
+}
+
+fn rms(r: &[f64; 8]) -> f64 {
+    (r.iter().map(|v| v * v).sum::<f64>() / 4.0).sqrt()
+}
+
+/// Levenberg–Marquardt on the pose (a rotation-vector step on the left, and the translation);
+/// returns the refined pose and its RMS corner error in pixels.
+fn refine(
+    mut q: DQuat,
+    mut t: DVec3,
+    obj: &[DVec3; 4],
+    px: &[DVec2; 4],
+    k: &Intrinsics,
+) -> (DQuat, DVec3, f64) {
+    let mut r = residuals(q, t, obj, px, k);
+    let mut cost = rms(&r);
+    let mut mu = 1e-3;
+    let apply = |q: DQuat, t: DVec3, d: &[f64; 6]| {
+        let w = DVec3::new(d[0], d[1], d[2]);
+        let dq = if w.length() > 0.0 {
+            DQuat::from_scaled_axis(w)
+        } else {
+            DQuat::IDENTITY
+        };
+        ((dq * q).normalize(), t + DVec3::new(d[3], d[4], d[5]))
+    };
+    for _ in 0..30 {
+        // Numerical Jacobian: 6 columns of 8 residuals.
+        let mut jac = [[0.0; 8]; 6];
+        for (j, col) in jac.iter_mut().enumerate() {
+            let step = if j < 3 { 1e-6 } else { 1e-7 };
+            let mut d = [0.0; 6];
+            d[j] = step;
+            let (q1, t1) = apply(q, t, &d);
+            let r1 = residuals(q1, t1, obj, px, k);
+            for i in 0..8 {
+                col[i] = (r1[i] - r[i]) / step;
+            }
+        }
+        let mut jtj = [[0.0; 6]; 6];
+        let mut jtr = [0.0; 6];
+        for a in 0..6 {
+            for b in 0..6 {
+                jtj[a][b] = (0..8).map(|i| jac[a][i] * jac[b][i]).sum();
+            }
+            jtr[a] = -(0..8).map(|i| jac[a][i] * r[i]).sum::<f64>();
+        }
+        let mut improved = false;
+        for _ in 0..8 {
+            let mut damped = jtj;
+            for (a, row) in damped.iter_mut().enumerate() {
+                row[a] += mu * jtj[a][a].max(1e-9);
+            }
+            let Some(d) = solve_linear(damped, jtr) else {
+                mu *= 10.0;
+                continue;
+            };
+            let (q1, t1) = apply(q, t, &d);
+            let r1 = residuals(q1, t1, obj, px, k);
+            let c1 = rms(&r1);
+            if c1 < cost && t1.z > 0.0 {
+                let gain = cost - c1;
+                (q, t, r, cost) = (q1, t1, r1, c1);
+                mu = (mu * 0.3).max(1e-9);
+                improved = gain > 1e-9;
+                break;
+            }
+            mu *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    (q, t, cost)
+}
+
+/// The other pose a flat square nearly equally explains: its normal mirrored about the line
+/// of sight.
+fn mirrored(q: DQuat, t: DVec3) -> Option<DQuat> {
+    let v = t.try_normalize()?;
+    let n = q * DVec3::Z;
+    let n2 = 2.0 * n.dot(v) * v - n;
+    let turn = DQuat::from_rotation_arc(n, n2.try_normalize()?);
+    Some((turn * q).normalize())
+}
+
+/// The tag's pose from its corners (pixels, detector order), its edge `size` (metres) and the
+/// camera; `previous` (the last tag→camera rotation) breaks near ties. The error is the RMS
+/// corner reprojection error in pixels.
+pub fn solve_pose(
+    corners: &[[f64; 2]; 4],
+    size: f64,
+    k: &Intrinsics,
+    previous: Option<DQuat>,
+) -> Option<CameraPose> {
+    let obj = object_corners(size);
+    let px: [DVec2; 4] = corners.map(|c| DVec2::new(c[0], c[1]));
+    let norm = px.map(|p| DVec2::new((p.x - k.cx) / k.fx, (p.y - k.cy) / k.fy));
+    let h = homography(&obj, &norm)?;
+    let (q0, t0) = pose_from_homography(h)?;
+    let mut best = refine(q0, t0, &obj, &px, k);
+    if let Some(qm) = mirrored(best.0, best.1) {
+        let alt = refine(qm, best.1, &obj, &px, k);
+        let (lo, hi) = if alt.2 < best.2 {
+            (alt, best)
+        } else {
+            (best, alt)
+        };
+        best = lo;
+        if hi.2 <= lo.2 * TIE_FACTOR + TIE_PX {
+            if let Some(prev) = previous {
+                if hi.0.dot(prev).abs() > lo.0.dot(prev).abs() {
+                    best = hi;
+                }
+            }
+        }
+    }
+    let (q, t, err) = best;
+    if !(err.is_finite() && t.is_finite()) {
+        return None;
+    }
+    let m = DMat3::from_quat(q);
+    Some(CameraPose {
+        rotation: [
+            m.row(0).to_array(),
+            m.row(1).to_array(),
+            m.row(2).to_array(),
+        ],
+        translation: t.to_array(),
+        error: err,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::pose::intrinsics_from_fov;
+
+    fn corners(q: DQuat, t: DVec3, size: f64, k: &Intrinsics) -> [[f64; 2]; 4] {
+        object_corners(size).map(|p| {
+            let c = q * p + t;
+            [k.cx + k.fx * c.x / c.z, k.cy + k.fy * c.y / c.z]
+        })
+    }
+
+    #[test]
+    fn exact_corners_give_the_exact_pose() {
+        let k = intrinsics_from_fov(640, 480, 60.0);
+        for (q, t) in [
+            (
+                DQuat::from_euler(glam::EulerRot::YXZ, 0.5, -0.4, 0.3),
+                DVec3::new(0.05, -0.02, 0.6),
+            ),
+            (DQuat::from_rotation_y(1.0), DVec3::new(-0.1, 0.05, 1.0)),
+            (DQuat::IDENTITY, DVec3::new(0.0, 0.0, 0.3)),
+        ] {
+            let c = corners(q, t, 0.04, &k);
+            let p = solve_pose(&c, 0.04, &k, Some(q)).unwrap();
+            let t2 = DVec3::from_array(p.translation);
+            assert!((t2 - t).length() < 1e-6, "{t2} vs {t}");
+            let r = p.rotation;
+            let m = DMat3::from_cols(
+                DVec3::new(r[0][0], r[1][0], r[2][0]),
+                DVec3::new(r[0][1], r[1][1], r[2][1]),
+                DVec3::new(r[0][2], r[1][2], r[2][2]),
+            );
+            let q2 = DQuat::from_mat3(&m);
+            assert!(q2.dot(q).abs() > 1.0 - 1e-9);
+            assert!(p.error < 1e-6);
+        }
+    }
+
+    #[test]
+    fn degenerate_corners_give_no_pose() {
+        let k = intrinsics_from_fov(640, 480, 60.0);
+        assert!(solve_pose(&[[10.0, 10.0]; 4], 0.04, &k, None).is_none());
+    }
+}

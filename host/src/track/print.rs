@@ -1,0 +1,233 @@
+//! `figurine track print-tag`: a tag to print at its true size — a PNG whose pixel density is
+//! written in the file (so a print dialogue at 100 % keeps the size) or a one-page PDF drawn
+//! in millimetres. The pattern comes from libapriltag's own family table
+//! ([`super::detect::tag_pattern`]).
+
+use std::io::Write;
+use std::path::Path;
+
+use image::{Rgb, RgbImage};
+
+use super::detect::{Family, TagPattern};
+use super::TrackError;
+use crate::raster::{draw_text, text_width};
+
+/// Millimetres per inch.
+const MM_PER_INCH: f64 = 25.4;
+
+fn write_err(path: &Path, e: impl std::fmt::Display) -> TrackError {
+    TrackError::Write {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(e.to_string()),
+    }
+}
+
+/// The caption printed under the tag: what it is, its size, and how to stick it on.
+pub fn caption(family: Family, id: u32, size_m: f64) -> [String; 2] {
+    [
+        format!(
+            "{} ID {id}  BLACK SQUARE {:.1} MM: PRINT AT 100%",
+            family.name(),
+            size_m * 1000.0
+        ),
+        "ON THE CHEST OF THE FIGURINE, THIS WAY UP".to_string(),
+    ]
+}
+
+/// Draws the tag as a PNG: `px_per_cell` pixels per cell, with the pixel density that makes
+/// the black square `size_m` metres when printed at 100 %.
+pub fn tag_png(
+    pattern: &TagPattern,
+    lines: &[String; 2],
+    size_m: f64,
+    px_per_cell: u32,
+    path: &Path,
+) -> Result<(), TrackError> {
+    let cell = px_per_cell.max(1);
+    let tag_px = cell * pattern.width as u32;
+    let text_scale = (cell / 12).max(1);
+    let text_w = lines
+        .iter()
+        .map(|l| text_width(l, text_scale))
+        .max()
+        .unwrap_or(0);
+    let width = tag_px.max(text_w + 2 * cell);
+    let height = tag_px + 2 * 10 * text_scale + 2 * cell;
+    let mut img = RgbImage::from_pixel(width, height, Rgb([255, 255, 255]));
+    let x0 = (width - tag_px) / 2;
+    for y in 0..pattern.width {
+        for x in 0..pattern.width {
+            if pattern.is_black(x, y) {
+                for py in 0..cell {
+                    for px in 0..cell {
+                        img.put_pixel(
+                            x0 + x as u32 * cell + px,
+                            y as u32 * cell + py,
+                            Rgb([0, 0, 0]),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    let grey = Rgb([90, 90, 90]);
+    for (i, l) in lines.iter().enumerate() {
+        let w = text_width(l, text_scale);
+        let y = tag_px + cell / 2 + i as u32 * 10 * text_scale;
+        draw_text(
+            &mut img,
+            i64::from((width - w) / 2),
+            i64::from(y),
+            l,
+            text_scale,
+            grey,
+        );
+    }
+    // Pixels per metre such that the border square (border_width cells) is size_m.
+    let ppm = (f64::from(cell) * pattern.border_width as f64 / size_m).round() as u32;
+    let file = std::fs::File::create(path).map_err(|source| TrackError::Write {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_pixel_dims(Some(png::PixelDimensions {
+        xppu: ppm,
+        yppu: ppm,
+        unit: png::Unit::Meter,
+    }));
+    let mut w = enc.write_header().map_err(|e| write_err(path, e))?;
+    w.write_image_data(img.as_raw())
+        .map_err(|e| write_err(path, e))?;
+    w.finish().map_err(|e| write_err(path, e))
+}
+
+/// Writes the tag on an A4 page as a PDF in exact millimetres: one filled square per black
+/// cell, the caption in Helvetica below.
+pub fn tag_pdf(
+    pattern: &TagPattern,
+    lines: &[String; 2],
+    size_m: f64,
+    path: &Path,
+) -> Result<(), TrackError> {
+    let pt_per_m = 72.0 / MM_PER_INCH * 1000.0;
+    let cell = size_m / pattern.border_width as f64 * pt_per_m;
+    let (page_w, page_h) = (595.28, 841.89);
+    let side = cell * pattern.width as f64;
+    let (x0, top) = ((page_w - side) / 2.0, page_h - 120.0);
+    let mut content = String::from("0 g\n");
+    for y in 0..pattern.width {
+        for x in 0..pattern.width {
+            if pattern.is_black(x, y) {
+                // Cells overlap by a hair so no viewer draws seams between them.
+                content.push_str(&format!(
+                    "{:.3} {:.3} {:.3} {:.3} re f\n",
+                    x0 + x as f64 * cell,
+                    top - (y + 1) as f64 * cell,
+                    cell + 0.02,
+                    cell + 0.02
+                ));
+            }
+        }
+    }
+    for (i, l) in lines.iter().enumerate() {
+        let text = l
+            .replace('\\', "\\\\")
+            .replace('(', "\\(")
+            .replace(')', "\\)");
+        content.push_str(&format!(
+            "BT /F1 10 Tf {:.2} {:.2} Td ({text}) Tj ET\n",
+            x0,
+            top - side - 20.0 - 14.0 * i as f64
+        ));
+    }
+    let objects = [
+        "<< /Type /Catalog /Pages 2 0 R >>".to_string(),
+        "<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_string(),
+        format!(
+            "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {page_w} {page_h}] \
+             /Resources << /Font << /F1 5 0 R >> >> /Contents 4 0 R >>"
+        ),
+        format!(
+            "<< /Length {} >>\nstream\n{content}endstream",
+            content.len()
+        ),
+        "<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica >>".to_string(),
+    ];
+    let mut out = Vec::new();
+    out.extend_from_slice(b"%PDF-1.4\n");
+    let mut offsets = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        offsets.push(out.len());
+        out.extend_from_slice(format!("{} 0 obj\n{o}\nendobj\n", i + 1).as_bytes());
+    }
+    let xref = out.len();
+    out.extend_from_slice(
+        format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1).as_bytes(),
+    );
+    for off in offsets {
+        out.extend_from_slice(format!("{off:010} 00000 n \n").as_bytes());
+    }
+    out.extend_from_slice(
+        format!(
+            "trailer\n<< /Size {} /Root 1 0 R >>\nstartxref\n{xref}\n%%EOF\n",
+            objects.len() + 1
+        )
+        .as_bytes(),
+    );
+    std::fs::File::create(path)
+        .and_then(|mut f| f.write_all(&out))
+        .map_err(|source| TrackError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::detect::{tag_pattern, Detector, DetectorSettings, GrayFrame};
+
+    #[test]
+    fn the_printed_png_is_detected_and_says_its_size() {
+        let dir = std::env::temp_dir().join(format!("figurine-print-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("tag.png");
+        let pattern = tag_pattern(Family::Tag36h11, 7).unwrap();
+        tag_png(
+            &pattern,
+            &caption(Family::Tag36h11, 7, 0.04),
+            0.04,
+            20,
+            &path,
+        )
+        .unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let dec = png::Decoder::new(std::io::Cursor::new(bytes));
+        let reader = dec.read_info().unwrap();
+        let dims = reader.info().pixel_dims.unwrap();
+        // 8 cells × 20 px over 40 mm: 4000 px/m.
+        assert_eq!(dims.xppu, 4000);
+        let img = image::open(&path).unwrap().to_luma8();
+        // A white margin so the detector sees the tag's outer white ring.
+        let mut frame = GrayFrame {
+            width: img.width() as usize + 40,
+            height: img.height() as usize + 40,
+            pixels: vec![255; (img.width() as usize + 40) * (img.height() as usize + 40)],
+        };
+        for (x, y, p) in img.enumerate_pixels() {
+            frame.pixels[(y as usize + 20) * frame.width + x as usize + 20] = p.0[0];
+        }
+        let mut d = Detector::new(Family::Tag36h11, DetectorSettings::default()).unwrap();
+        let found = d.detect(&frame);
+        assert_eq!(found.iter().map(|d| d.id).collect::<Vec<_>>(), vec![7]);
+        let pdf = dir.join("tag.pdf");
+        tag_pdf(&pattern, &caption(Family::Tag36h11, 7, 0.04), 0.04, &pdf).unwrap();
+        let text = std::fs::read_to_string(&pdf).unwrap();
+        assert!(text.starts_with("%PDF-1.4") && text.ends_with("%%EOF\n"));
+        // 5 mm cells are 14.173 pt.
+        assert!(text.contains(" 14.193 14.193 re f"), "cell size in points");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

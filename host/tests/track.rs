@@ -1,0 +1,380 @@
+//! End-to-end tests of `figurine track`: rendered videos of a tag on a moving figurine, encoded
+//! to MP4, tracked, and compared with the poses that were drawn; the printed tag; and the
+//! errors bad input gets.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use figurine_host::poselog::{PoseLog, PoseSample};
+use figurine_host::synth::Action;
+use figurine_host::track::bench::run_gesture;
+use figurine_host::track::eval::{summarize, Setup};
+use glam::{DQuat, DVec3};
+
+fn figurine(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_figurine"))
+        .args(args)
+        .output()
+        .expect("run figurine")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("figurine-track-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A failed run that explains itself and did not panic.
+fn fails_saying(out: &Output, words: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "should fail: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    for w in words {
+        assert!(err.contains(w), "`{w}` not in: {err}");
+    }
+}
+
+#[test]
+fn a_gesture_is_tracked_within_goals_and_reads_as_the_same_action() {
+    let dir = scratch("gesture");
+    let setup = Setup {
+        distance: 0.6,
+        seed: 5,
+        ..Setup::default()
+    };
+    let run = run_gesture(&setup, Action::Sidestep, 4, &dir, true).unwrap();
+    let all = summarize(&run.frames);
+    assert!(all.frames > 30, "{} frames", all.frames);
+    assert!(
+        all.lost_visible_share() < 0.05,
+        "{:.1} % of frames in sight lost",
+        100.0 * all.lost_visible_share()
+    );
+    assert!(
+        all.pos_median_mm < 5.0,
+        "position {:.1} mm",
+        all.pos_median_mm
+    );
+    assert!(
+        all.ori_median_deg < 2.0,
+        "orientation {:.2}°",
+        all.ori_median_deg
+    );
+    assert_eq!(run.truth_actions, vec!["sidestep".to_string()]);
+    assert_eq!(run.tracked_actions, run.truth_actions);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A short path: still, then a slide to the figurine's left and a quarter turn.
+fn short_path() -> PoseLog {
+    PoseLog {
+        samples: (0..=120)
+            .map(|i| {
+                let t = i as f64 / 120.0;
+                let s = ((t - 0.3) / 0.5).clamp(0.0, 1.0);
+                let q = DQuat::from_rotation_y(0.6 * s);
+                PoseSample {
+                    t,
+                    pos: [0.15 * s, 0.02 * s, 0.0],
+                    quat: [q.w, q.x, q.y, q.z],
+                }
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn the_cli_renders_tracks_and_draws_the_overlay() {
+    let dir = scratch("cli");
+    let path = dir.join("path.csv");
+    short_path().write_path(&path).unwrap();
+    let (video, truth, tracked, overlay) = (
+        dir.join("v.mp4"),
+        dir.join("truth.csv"),
+        dir.join("tracked.csv"),
+        dir.join("overlay.png"),
+    );
+    let out = figurine(&[
+        "track",
+        "render",
+        "--log",
+        s(&path),
+        "--out",
+        s(&video),
+        "--truth",
+        s(&truth),
+        "--distance",
+        "0.5",
+        "--seed",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = figurine(&[
+        "track",
+        "--video",
+        s(&video),
+        "--tag-size",
+        "0.04",
+        "--out",
+        s(&tracked),
+        "--overlay",
+        s(&overlay),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let truth = PoseLog::read_path(&truth).unwrap();
+    let tracked = PoseLog::read_path(&tracked).unwrap();
+    assert!(
+        tracked.samples.len() + 3 >= truth.samples.len(),
+        "frames lost"
+    );
+    for t in &tracked.samples {
+        let want = truth
+            .samples
+            .iter()
+            .find(|w| (w.t - t.t).abs() < 1e-5)
+            .expect("a sample at a frame time");
+        let err = (DVec3::from_array(t.pos) - DVec3::from_array(want.pos)).length();
+        assert!(err < 0.01, "{:.1} mm at {}", err * 1000.0, t.t);
+    }
+    // Moved left (+x of the camera's world: the figurine faces the camera) and turned.
+    let (a, b) = (&tracked.samples[0], tracked.samples.last().unwrap());
+    assert!(b.pos[0] - a.pos[0] > 0.12);
+    assert!(image::open(&overlay).unwrap().width() == 640);
+    // `--out -`: the same log on stdout, a line per frame, for `figurine live`'s stdin.
+    let out = figurine(&["track", "--video", s(&video), "--out", "-"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let piped = PoseLog::read(&out.stdout[..], Path::new("stdout")).unwrap();
+    assert_eq!(piped.samples.len(), tracked.samples.len());
+    for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
+        assert!(
+            figurine_host::link::live::parse_pose_line(line).is_some(),
+            "{line}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn print_tag_writes_png_and_pdf() {
+    let dir = scratch("print");
+    for name in ["tag.png", "tag.pdf"] {
+        let p = dir.join(name);
+        let out = figurine(&[
+            "track",
+            "print-tag",
+            "--id",
+            "3",
+            "--size",
+            "0.05",
+            "--out",
+            s(&p),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::metadata(&p).unwrap().len() > 100);
+    }
+    fails_saying(
+        &figurine(&[
+            "track",
+            "print-tag",
+            "--id",
+            "9999",
+            "--out",
+            s(&dir.join("x.png")),
+        ]),
+        &["tag36h11 has ids 0..587, not 9999"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_input_gets_clear_errors() {
+    let dir = scratch("bad");
+    // No tag: the figurine shows the camera its back the whole time.
+    let path = dir.join("back.csv");
+    let q = DQuat::from_rotation_y(std::f64::consts::PI);
+    let back = PoseLog {
+        samples: (0..=20)
+            .map(|i| PoseSample {
+                t: i as f64 / 60.0,
+                pos: [0.0, 0.0, -0.5],
+                quat: [q.w, q.x, q.y, q.z],
+            })
+            .collect(),
+    };
+    back.write_path(&path).unwrap();
+    let video = dir.join("back.mp4");
+    let out = figurine(&[
+        "track",
+        "render",
+        "--log",
+        s(&path),
+        "--out",
+        s(&video),
+        "--as-is",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = dir.join("log.csv");
+    fails_saying(
+        &figurine(&["track", "--video", s(&video), "--out", s(&log)]),
+        &["no tag36h11 tag 0 in any of", "frames"],
+    );
+    // Not a video, and no file at all.
+    let junk = dir.join("junk.mp4");
+    std::fs::write(&junk, b"not a video at all").unwrap();
+    fails_saying(
+        &figurine(&["track", "--video", s(&junk), "--out", s(&log)]),
+        &["junk.mp4", "cannot read the video"],
+    );
+    fails_saying(
+        &figurine(&[
+            "track",
+            "--video",
+            s(&dir.join("none.mp4")),
+            "--out",
+            s(&log),
+        ]),
+        &["none.mp4", "no such file"],
+    );
+    // A camera that is not there, and a file that is not a camera.
+    fails_saying(
+        &figurine(&["track", "--camera", "/dev/video-none-9", "--out", s(&log)]),
+        &["/dev/video-none-9", "no such camera"],
+    );
+    fails_saying(
+        &figurine(&["track", "--camera", "/dev/null", "--out", s(&log)]),
+        &["not a video device"],
+    );
+    // Calibration files that hold no camera.
+    let cal = dir.join("cal.json");
+    for (text, why) in [
+        ("{ not json", "bad calibration file"),
+        (
+            r#"{"width":640,"height":480,"fx":-5,"fy":500,"cx":320,"cy":240}"#,
+            "fx must be a positive",
+        ),
+        (r#"{"width":640}"#, "missing field"),
+    ] {
+        std::fs::write(&cal, text).unwrap();
+        fails_saying(
+            &figurine(&[
+                "track",
+                "--video",
+                s(&video),
+                "--calibration",
+                s(&cal),
+                "--out",
+                s(&log),
+            ]),
+            &["cal.json", why],
+        );
+    }
+    fails_saying(
+        &figurine(&[
+            "track",
+            "--video",
+            s(&video),
+            "--tag-size=-1",
+            "--out",
+            s(&log),
+        ]),
+        &["--tag-size"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
+    let dir = scratch("calibrate");
+    // The tag waved through tilts 0.35 m ahead of a 72° camera, already in its world frame.
+    let path = dir.join("wave.csv");
+    let waved = PoseLog {
+        samples: (0..30)
+            .map(|i| {
+                let a = i as f64 * 0.45;
+                let q = DQuat::from_euler(glam::EulerRot::YXZ, 0.6 * a.cos(), 0.5 * a.sin(), 0.1);
+                PoseSample {
+                    t: i as f64 / 30.0,
+                    pos: [0.03 * a.sin(), 0.0, -0.35],
+                    quat: [q.w, q.x, q.y, q.z],
+                }
+            })
+            .collect(),
+    };
+    waved.write_path(&path).unwrap();
+    let video = dir.join("wave.mp4");
+    let out = figurine(&[
+        "track",
+        "render",
+        "--log",
+        s(&path),
+        "--out",
+        s(&video),
+        "--as-is",
+        "--fov",
+        "72",
+        "--clean",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let cal = dir.join("cal.json");
+    let out = figurine(&["track", "calibrate", "--video", s(&video), "--out", s(&cal)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let c = figurine_host::track::pose::Calibration::read(&cal).unwrap();
+    let f_true = 320.0 / 36f64.to_radians().tan();
+    assert!((c.fx / f_true - 1.0).abs() < 0.03, "f {} vs {f_true}", c.fx);
+    // Tracking with it gets the depth right; the default 60° guess gets it 24 % long.
+    let depth = |extra: &[&str]| {
+        let log = dir.join("tracked.csv");
+        let mut args = vec!["track", "--video", s(&video), "--out", s(&log)];
+        args.extend_from_slice(extra);
+        let out = figurine(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let l = PoseLog::read_path(&log).unwrap();
+        l.samples.iter().map(|p| -p.pos[2]).sum::<f64>() / l.samples.len() as f64
+    };
+    let calibrated = depth(&["--calibration", s(&cal)]);
+    assert!((calibrated - 0.35).abs() < 0.01, "{calibrated} m");
+    let guessed = depth(&[]);
+    let expected = 0.35 * 36f64.to_radians().tan() / 30f64.to_radians().tan();
+    assert!(
+        (guessed - expected).abs() < 0.015,
+        "{guessed} m vs {expected} m"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
