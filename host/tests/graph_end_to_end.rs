@@ -1,34 +1,13 @@
 //! End to end: `figurine graph build | synth | eval` on the real DeepMimic clips, the output BVH
 //! re-imported and checked for continuity (no pops at transitions).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-use figurine_host::data::data_dir;
+use std::path::{Path, PathBuf};
+
+use common::{deepmimic_dir, figurine};
 use figurine_host::graph::source::load_clip;
 use figurine_host::motion::read_bvh_path;
-
-fn deepmimic_dir() -> Option<PathBuf> {
-    let d = data_dir().join("deepmimic");
-    if d.join("humanoid.urdf").is_file() && d.join("humanoid3d_walk.txt").is_file() {
-        Some(d)
-    } else {
-        eprintln!("skipping: DeepMimic data not found; run `cargo xtask setup`");
-        None
-    }
-}
-
-fn figurine(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_figurine"))
-        .args(args)
-        .output()
-        .expect("run figurine");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 /// Largest per-frame displacement of any joint, in the clip's unit.
 fn max_step(clip: &figurine_host::motion::Clip) -> f32 {

@@ -2,13 +2,13 @@
 //! (by hand, and as a Slurm job array on a single-node cluster started for the test), `graph
 //! merge`, and the merged file compared byte for byte with `graph build`.
 
+mod common;
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
-use figurine_host::data::data_dir;
+use common::{deepmimic_dir, figurine};
 use support::slurm::Cluster;
 
 /// Build options of both paths: looser thresholds (14 short clips), small kernel tiles so the
@@ -16,28 +16,6 @@ use support::slurm::Cluster;
 const OPTS: [&str; 6] = ["--t-mg", "0.85", "--t-lma", "0.7", "--tile", "64"];
 /// Frames per band: 3 bands over DeepMimic's 989 usable frames, 6 tiles.
 const BAND: &str = "384";
-
-fn deepmimic_dir() -> Option<PathBuf> {
-    let d = data_dir().join("deepmimic");
-    if d.join("humanoid.urdf").is_file() && d.join("humanoid3d_walk.txt").is_file() {
-        Some(d)
-    } else {
-        eprintln!("skipping: DeepMimic data not found; run `cargo xtask setup`");
-        None
-    }
-}
-
-fn figurine(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_figurine"))
-        .args(args)
-        .output()
-        .expect("run figurine");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("figurine-tiles-{}-{name}", std::process::id()));
