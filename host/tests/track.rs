@@ -29,6 +29,18 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// Runs `figurine ARGS` and asserts it succeeded (showing its stderr if not).
+fn succeeds(args: &[&str]) -> Output {
+    let out = figurine(args);
+    assert!(
+        out.status.success(),
+        "figurine {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// A failed run that explains itself and did not panic.
 fn fails_saying(out: &Output, words: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -99,7 +111,7 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
         dir.join("tracked.csv"),
         dir.join("overlay.png"),
     );
-    let out = figurine(&[
+    succeeds(&[
         "track",
         "render",
         "--log",
@@ -113,12 +125,7 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
         "--seed",
         "2",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = figurine(&[
+    succeeds(&[
         "track",
         "--video",
         s(&video),
@@ -129,11 +136,6 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
         "--overlay",
         s(&overlay),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let truth = PoseLog::read_path(&truth).unwrap();
     let tracked = PoseLog::read_path(&tracked).unwrap();
     assert!(
@@ -154,12 +156,7 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
     assert!(b.pos[0] - a.pos[0] > 0.12);
     assert!(image::open(&overlay).unwrap().width() == 640);
     // `--out -`: the same log on stdout, a line per frame, for `figurine live`'s stdin.
-    let out = figurine(&["track", "--video", s(&video), "--out", "-"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeeds(&["track", "--video", s(&video), "--out", "-"]);
     let piped = PoseLog::read(&out.stdout[..], Path::new("stdout")).unwrap();
     assert_eq!(piped.samples.len(), tracked.samples.len());
     for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
@@ -176,7 +173,7 @@ fn print_tag_writes_png_and_pdf() {
     let dir = scratch("print");
     for name in ["tag.png", "tag.pdf"] {
         let p = dir.join(name);
-        let out = figurine(&[
+        succeeds(&[
             "track",
             "print-tag",
             "--id",
@@ -186,11 +183,6 @@ fn print_tag_writes_png_and_pdf() {
             "--out",
             s(&p),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         assert!(std::fs::metadata(&p).unwrap().len() > 100);
     }
     fails_saying(
@@ -224,7 +216,7 @@ fn bad_input_gets_clear_errors() {
     };
     back.write_path(&path).unwrap();
     let video = dir.join("back.mp4");
-    let out = figurine(&[
+    succeeds(&[
         "track",
         "render",
         "--log",
@@ -233,11 +225,6 @@ fn bad_input_gets_clear_errors() {
         s(&video),
         "--as-is",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let log = dir.join("log.csv");
     fails_saying(
         &figurine(&["track", "--video", s(&video), "--out", s(&log)]),
@@ -327,7 +314,7 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
     };
     waved.write_path(&path).unwrap();
     let video = dir.join("wave.mp4");
-    let out = figurine(&[
+    succeeds(&[
         "track",
         "render",
         "--log",
@@ -339,18 +326,8 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
         "72",
         "--clean",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let cal = dir.join("cal.json");
-    let out = figurine(&["track", "calibrate", "--video", s(&video), "--out", s(&cal)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(&["track", "calibrate", "--video", s(&video), "--out", s(&cal)]);
     let c = figurine_host::track::pose::Calibration::read(&cal).unwrap();
     let f_true = 320.0 / 36f64.to_radians().tan();
     assert!((c.fx / f_true - 1.0).abs() < 0.03, "f {} vs {f_true}", c.fx);

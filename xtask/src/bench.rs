@@ -5,17 +5,20 @@ use anyhow::Result;
 
 use crate::util::{cargo, root, run, step};
 
-/// Runs one of the host crate's benchmark examples in release mode.
-fn host_example(name: &str) -> Result<()> {
-    run(cargo().args([
-        "run",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--example",
-        name,
-    ]))
+/// Runs one of the host crate's benchmark examples in release mode, with `args`.
+fn host_example(name: &str, args: &[&str]) -> Result<()> {
+    run(cargo()
+        .args([
+            "run",
+            "-q",
+            "--release",
+            "-p",
+            "figurine-host",
+            "--example",
+            name,
+            "--",
+        ])
+        .args(args))
 }
 
 /// Runs `figurine ARGS…` built in release mode.
@@ -100,10 +103,10 @@ pub fn bench() -> Result<()> {
     ]))?;
 
     step("render: 30 s at 30 fps, 1280x720 (cargo run --release -p figurine-host --example render_bench)");
-    host_example("render_bench")?;
+    host_example("render_bench", &[])?;
 
     step("motion graph build at ~10k/27k/54k frames (cargo run --release -p figurine-host --example graph_bench)");
-    host_example("graph_bench")?;
+    host_example("graph_bench", &[])?;
 
     step("distributed motion graph, 54k frames: graph build vs a Slurm job array of tiles and a dependent merge (cargo run --release -p figurine-host --example graph_bench -- engine)");
     // The job array runs the release `figurine` binary.
@@ -116,17 +119,7 @@ pub fn bench() -> Result<()> {
         "--bin",
         "figurine",
     ]))?;
-    run(cargo().args([
-        "run",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--example",
-        "graph_bench",
-        "--",
-        "engine",
-    ]))?;
+    host_example("graph_bench", &["engine"])?;
 
     Ok(())
 }
