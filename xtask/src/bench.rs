@@ -5,8 +5,8 @@ use anyhow::Result;
 
 use crate::util::{cargo, root, run, step};
 
-/// Runs one of the host crate's benchmark examples in release mode, with `args`.
-fn host_example(name: &str, args: &[&str]) -> Result<()> {
+/// Runs a host-crate target (`--example NAME` or `--bin figurine`) in release mode, with `args`.
+fn host_run(kind: &str, name: &str, args: &[&str]) -> Result<()> {
     run(cargo()
         .args([
             "run",
@@ -14,27 +14,21 @@ fn host_example(name: &str, args: &[&str]) -> Result<()> {
             "--release",
             "-p",
             "figurine-host",
-            "--example",
+            kind,
             name,
             "--",
         ])
         .args(args))
 }
 
+/// Runs one of the host crate's benchmark examples in release mode, with `args`.
+fn host_example(name: &str, args: &[&str]) -> Result<()> {
+    host_run("--example", name, args)
+}
+
 /// Runs `figurine ARGS…` built in release mode.
 fn figurine(args: &[&str]) -> Result<()> {
-    run(cargo()
-        .args([
-            "run",
-            "-q",
-            "--release",
-            "-p",
-            "figurine-host",
-            "--bin",
-            "figurine",
-            "--",
-        ])
-        .args(args))
+    host_run("--bin", "figurine", args)
 }
 
 /// Runs every benchmark in turn, each printing its own figures with its command; the plots go
@@ -110,15 +104,7 @@ pub fn bench() -> Result<()> {
 
     step("distributed motion graph, 54k frames: graph build vs a Slurm job array of tiles and a dependent merge (cargo run --release -p figurine-host --example graph_bench -- engine)");
     // The job array runs the release `figurine` binary.
-    run(cargo().args([
-        "build",
-        "-q",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--bin",
-        "figurine",
-    ]))?;
+    crate::util::build_figurine()?;
     host_example("graph_bench", &["engine"])?;
 
     Ok(())

@@ -15,7 +15,7 @@ use std::process::Command;
 
 use anyhow::{Context, Result};
 
-use crate::util::{cargo, root, run, step};
+use crate::util::{root, run, step};
 
 /// Seed of the bundled demo doodle.
 const DEMO_SEED: &str = "2026";
@@ -30,14 +30,7 @@ fn figurine(bin: &Path) -> Command {
 pub fn demo() -> Result<PathBuf> {
     crate::setup::setup()?;
     step("demo: build figurine (release)");
-    run(cargo().args([
-        "build",
-        "--release",
-        "-p",
-        "figurine-host",
-        "--bin",
-        "figurine",
-    ]))?;
+    crate::util::build_figurine()?;
     let bin = root().join("target/release/figurine");
     let out = root().join("target/demo");
     std::fs::create_dir_all(&out)?;

@@ -65,3 +65,15 @@ pub fn cargo() -> Command {
     }
     c
 }
+
+/// Builds the release `figurine` binary (`target/release/figurine`).
+pub fn build_figurine() -> Result<()> {
+    run(cargo().args([
+        "build",
+        "--release",
+        "-p",
+        "figurine-host",
+        "--bin",
+        "figurine",
+    ]))
+}
