@@ -382,7 +382,11 @@ pub struct CheckArgs {
 /// Every default action in the four effort corners and neutral, each assembled along a
 /// doodle generated at `seed` from its label (as `figurine animate --labels` does), judged.
 pub fn check_defaults(seed: u64) -> Result<Vec<Plausibility>> {
-    let (anims, _) = super::defaults::default_animations(seed)?;
+    check_animations(&super::defaults::default_animations(seed)?.0)
+}
+
+/// Judges assembled default animations, each labelled "ACTION EFFORT".
+fn check_animations(anims: &[super::defaults::DefaultAnimation]) -> Result<Vec<Plausibility>> {
     anims
         .iter()
         .map(|a| {
@@ -446,10 +450,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     }
     if a.defaults {
         let (anims, forward) = super::defaults::default_animations(a.seed)?;
-        for anim in &anims {
-            let label = format!("{} {}", anim.action, anim.effort);
-            rows.push(check_clip(&anim.assembly.clip, Ground::At(0.0), &label)?);
-        }
+        rows.extend(check_animations(&anims)?);
         if let Some(dir) = &a.sheets {
             let written = super::defaults::write_effort_sheets(&anims, forward, dir)?;
             eprintln!("{} effort sheets in {}", written.len(), dir.display());
