@@ -5,7 +5,8 @@
 //! (≥ [`DOM_ON`] to switch on, stays on down to [`DOM_OFF`]: hysteresis against flicker on bin
 //! borders), so direction bins depend on the direction of motion only — not on its size or
 //! speed. A whole vector (translation or rotation) counts only when it moves against the
-//! sensor's noise as learnt from the stream ([`crate::noise`]) and exceeds [`REL_ACTIVE`] ×
+//! sensor's noise as learnt from the stream ([`crate::noise`]; motion found only by its slow
+//! mean takes its direction from that mean) and exceeds [`REL_ACTIVE`] ×
 //! its own recent peak (decaying with time constant [`PEAK_TAU_S`]): thresholds are relative
 //! to the tracker's noise and to the motion's own scale, and sensor noise during a pure turn
 //! does not become translation (nor tremor during a slide rotation). Translation smaller than [`ARM_M`] × |ω| is what a figurine
