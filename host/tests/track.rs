@@ -41,6 +41,26 @@ fn succeeds(args: &[&str]) -> Output {
     out
 }
 
+/// Writes `log` as `dir/NAME.csv` and renders it, already in the camera's frame
+/// (`track render --as-is`, plus `extra`), to `dir/NAME.mp4`; returns the video's path.
+fn render_as_is(dir: &Path, name: &str, log: &PoseLog, extra: &[&str]) -> PathBuf {
+    let path = dir.join(format!("{name}.csv"));
+    log.write_path(&path).unwrap();
+    let video = dir.join(format!("{name}.mp4"));
+    let mut args = vec![
+        "track",
+        "render",
+        "--log",
+        s(&path),
+        "--out",
+        s(&video),
+        "--as-is",
+    ];
+    args.extend_from_slice(extra);
+    succeeds(&args);
+    video
+}
+
 /// A failed run that explains itself and did not panic.
 fn fails_saying(out: &Output, words: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -203,7 +223,6 @@ fn print_tag_writes_png_and_pdf() {
 fn bad_input_gets_clear_errors() {
     let dir = scratch("bad");
     // No tag: the figurine shows the camera its back the whole time.
-    let path = dir.join("back.csv");
     let q = DQuat::from_rotation_y(std::f64::consts::PI);
     let back = PoseLog {
         samples: (0..=20)
@@ -214,17 +233,7 @@ fn bad_input_gets_clear_errors() {
             })
             .collect(),
     };
-    back.write_path(&path).unwrap();
-    let video = dir.join("back.mp4");
-    succeeds(&[
-        "track",
-        "render",
-        "--log",
-        s(&path),
-        "--out",
-        s(&video),
-        "--as-is",
-    ]);
+    let video = render_as_is(&dir, "back", &back, &[]);
     let log = dir.join("log.csv");
     fails_saying(
         &figurine(&["track", "--video", s(&video), "--out", s(&log)]),
@@ -298,7 +307,6 @@ fn bad_input_gets_clear_errors() {
 fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
     let dir = scratch("calibrate");
     // The tag waved through tilts 0.35 m ahead of a 72° camera, already in its world frame.
-    let path = dir.join("wave.csv");
     let waved = PoseLog {
         samples: (0..30)
             .map(|i| {
@@ -312,20 +320,7 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
             })
             .collect(),
     };
-    waved.write_path(&path).unwrap();
-    let video = dir.join("wave.mp4");
-    succeeds(&[
-        "track",
-        "render",
-        "--log",
-        s(&path),
-        "--out",
-        s(&video),
-        "--as-is",
-        "--fov",
-        "72",
-        "--clean",
-    ]);
+    let video = render_as_is(&dir, "wave", &waved, &["--fov", "72", "--clean"]);
     let cal = dir.join("cal.json");
     succeeds(&["track", "calibrate", "--video", s(&video), "--out", s(&cal)]);
     let c = figurine_host::track::pose::Calibration::read(&cal).unwrap();

@@ -432,26 +432,23 @@ pub fn gaussian_blur(img: &mut [f64], w: usize, h: usize, sigma: f64) {
     let total: f64 = kernel.iter().sum();
     let kernel: Vec<f64> = kernel.iter().map(|k| k / total).collect();
     let mut tmp = vec![0.0; img.len()];
-    for y in 0..h {
-        for x in 0..w {
-            let mut s = 0.0;
-            for (j, k) in kernel.iter().enumerate() {
-                let xx = (x as isize + j as isize - r).clamp(0, w as isize - 1) as usize;
-                s += k * img[y * w + xx];
+    // Rows, then columns: one pass along `len` samples `step` apart, for `lines` lines
+    // starting `across` apart.
+    let pass =
+        |src: &[f64], dst: &mut [f64], len: usize, step: usize, lines: usize, across: usize| {
+            for line in 0..lines {
+                for i in 0..len {
+                    let mut s = 0.0;
+                    for (j, k) in kernel.iter().enumerate() {
+                        let ii = (i as isize + j as isize - r).clamp(0, len as isize - 1) as usize;
+                        s += k * src[line * across + ii * step];
+                    }
+                    dst[line * across + i * step] = s;
+                }
             }
-            tmp[y * w + x] = s;
-        }
-    }
-    for y in 0..h {
-        for x in 0..w {
-            let mut s = 0.0;
-            for (j, k) in kernel.iter().enumerate() {
-                let yy = (y as isize + j as isize - r).clamp(0, h as isize - 1) as usize;
-                s += k * tmp[yy * w + x];
-            }
-            img[y * w + x] = s;
-        }
-    }
+        };
+    pass(img, &mut tmp, w, 1, h, w);
+    pass(&tmp, img, h, w, w, 1);
 }
 
 #[cfg(test)]
