@@ -6,12 +6,15 @@
 //! and at most [`CONTINUE_GAP_RUNS`] moving runs between them, is one of:
 //!
 //! - **its next piece**: the same action, and the runs from the held event's start to the
-//!   match's end are together one whole match of it — for a cyclic action (walk, wave) any
-//!   next cycle. A turn made in two twists with a breath between is one turn; two punches are
-//!   still two punches, since `b f b b f b` is no punch. The held event is extended.
-//! - **its rest**: another action's match that completes the held action's pattern at a lower
-//!   cost than it had alone. A throw committed at the pause after its release, whose return
-//!   stroke then matched a kick, is one throw. The held event is extended.
+//!   match's end are together one whole match of it, costing no more than the two matches
+//!   apart — for a cyclic action any next cycle. A turn made in two twists with a breath
+//!   between is one turn; two punches are still two punches, since `b f b b f b` is no punch,
+//!   and two jumps two jumps, though one jump's edit budget could swallow the second. The
+//!   held event is extended.
+//! - **its rest**: another action's match such that the held action's pattern over both costs
+//!   less than the two matches apart. A throw committed at the pause after its release, whose
+//!   return stroke then matched a kick, is one throw; a walk's next stride first read as a
+//!   poor kick is the walk going on. The held event is extended.
 //! - **its settling**: another action's match with under [`SETTLE_SHARE`] of the held event's
 //!   motion. A figurine that lands from a jump and gives at the knees (`d u`, a few
 //!   millimetres) has not crouched; nothing is reported.
@@ -127,14 +130,16 @@ pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate)
             weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, n.max(p.min_len())))
         });
     if h.action == c.action {
-        return if c.cyclic || cost.is_some() {
+        // One match over both must be no worse than the two apart: two jumps with a breath
+        // between are two jumps, even when one jump's edit budget could swallow the second.
+        return if c.cyclic || cost.is_some_and(|v| v <= h.cost.saturating_add(c.cost)) {
             Follow::Continues
         } else {
             Follow::New
         };
     }
     match cost {
-        Some(v) if v < h.cost => Follow::Completes(v),
+        Some(v) if v < h.cost.saturating_add(c.cost) => Follow::Completes(v),
         _ if mine < SETTLE_SHARE * motion(&h.acc) => Follow::Settles,
         _ => Follow::New,
     }
@@ -231,6 +236,36 @@ mod tests {
     }
 
     #[test]
+    fn a_repeat_that_one_match_swallows_only_at_a_cost_is_a_new_event() {
+        // A jump `d+ u+ d+` allowed two edits: `d u d d u d` is one jump with two extra
+        // strokes, but two exact jumps are the better reading.
+        let blob = seq_library(&[(&["d", "u", "d"], 2)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let (hist, o) = history(&[
+            ("d", 1.0),
+            ("u", 1.0),
+            ("d", 1.0),
+            ("_", 0.0),
+            ("d", 1.0),
+            ("u", 1.0),
+            ("d", 1.0),
+        ]);
+        let h = held(&hist, 0, o, o + 2, 0);
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(0, o + 4, o + 6, false)),
+            Follow::New
+        );
+        // A first piece that was itself a poor match (two edits) is completed by the second.
+        let (hist, o) = history(&[("d", 1.0), ("_", 0.0), ("u", 1.0), ("d", 1.0)]);
+        let mut h = held(&hist, 0, o, o, 2 * FULL);
+        h.distance = 2;
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(0, o + 2, o + 3, false)),
+            Follow::Continues
+        );
+    }
+
+    #[test]
     fn a_long_event_is_read_from_its_end() {
         let blob = seq_library(&[(&["uf", "df"], 0)]);
         let lib = Library::from_bytes(&blob).unwrap();
@@ -260,6 +295,13 @@ mod tests {
         let rest = cand(1, o + 3, o + 4, false);
         // `ub f db u`: one added stroke, where the throw alone had one left out: not cheaper.
         assert_eq!(follow(&lib, &hist, &h, &rest), Follow::New);
+        // … unless that other reading needed more edits than the throw over both does: one
+        // match no worse than the two apart (a walk's next stride first read as a poor kick).
+        let poor = Candidate {
+            cost: 2 * FULL,
+            ..rest
+        };
+        assert_eq!(follow(&lib, &hist, &h, &poor), Follow::Completes(FULL));
         // Its return alone (`db`) completes it exactly.
         let rest = cand(1, o + 3, o + 3, false);
         assert_eq!(follow(&lib, &hist, &h, &rest), Follow::Completes(0));

@@ -104,6 +104,9 @@ pub enum EvalCommand {
     /// Real doodles: motion-capture takes of people turned into figurine logs and labelled
     /// by hand (`host/assets/real_takes.json`), recognised; recall and precision.
     Real(super::real_bench::RealBenchArgs),
+    /// Repetitions: one action played 2–4 times back to back is as many events (one for a
+    /// walk, run, sidestep, wave or turn played on).
+    Repeat(super::repeat_bench::RepeatArgs),
 }
 
 impl EvalArgs {
@@ -294,6 +297,34 @@ impl ExtraEvents {
     }
 }
 
+/// For each label in order, the event it is matched to: the not yet matched event of its
+/// action that overlaps it most (none if no event of its action overlaps it).
+pub fn pair_events(labels: &[Label], evs: &[Ev]) -> Vec<Option<usize>> {
+    let mut used = vec![false; evs.len()];
+    labels
+        .iter()
+        .map(|l| {
+            let best = evs
+                .iter()
+                .enumerate()
+                .filter(|(i, e)| {
+                    !used[*i]
+                        && e.action == l.action
+                        && overlap(e.start, e.end, l.start, l.end) > 0.0
+                })
+                .max_by(|a, b| {
+                    overlap(a.1.start, a.1.end, l.start, l.end)
+                        .total_cmp(&overlap(b.1.start, b.1.end, l.start, l.end))
+                })
+                .map(|(i, _)| i);
+            if let Some(i) = best {
+                used[i] = true;
+            }
+            best
+        })
+        .collect()
+}
+
 fn label_ok(l: &Label, ev: &Ev) -> (bool, bool) {
     (
         (ev.time > 0.0) == (l.time_class == TimeClass::Sudden),
@@ -394,24 +425,13 @@ pub fn evaluate(
                 eprintln!("  event {:<9} {:7.2} {:7.2}", e.action, e.start, e.end);
             }
         }
+        let pairs = pair_events(&d.labels, &evs);
         let mut used = vec![false; evs.len()];
-        for l in &d.labels {
-            let best = evs
-                .iter()
-                .enumerate()
-                .filter(|(i, e)| {
-                    !used[*i]
-                        && e.action == l.action
-                        && overlap(e.start, e.end, l.start, l.end) > 0.0
-                })
-                .max_by(|a, b| {
-                    overlap(a.1.start, a.1.end, l.start, l.end)
-                        .total_cmp(&overlap(b.1.start, b.1.end, l.start, l.end))
-                });
-            if let Some((i, e)) = best {
+        for (l, &i) in d.labels.iter().zip(&pairs) {
+            if let Some(i) = i {
                 used[i] = true;
                 matched += 1;
-                f.latencies.push(e.decided - l.end);
+                f.latencies.push(evs[i].decided - l.end);
             }
         }
         for (e, _) in evs.iter().zip(&used).filter(|(_, u)| !**u) {
@@ -500,6 +520,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         Some(EvalCommand::Rest(a)) => return super::rest_bench::run(a),
         Some(EvalCommand::Sweep(a)) => return super::sweep::run(a),
         Some(EvalCommand::Real(a)) => return super::real_bench::run(a),
+        Some(EvalCommand::Repeat(a)) => return super::repeat_bench::run(a),
         None => {}
     }
     if args.pairs == 0 {

@@ -9,7 +9,8 @@
 //! - [`simulate`]: `figurine simulate`.
 //! - [`eval`] (+ [`eval_pairs`]): `figurine eval`; [`rest_bench`]: `figurine eval rest` (false
 //!   alarms per hour at rest); [`sweep`]: `figurine eval sweep` (robustness to noise, rate,
-//!   scale).
+//!   scale); [`repeat_bench`]: `figurine eval repeat` (one action played several times back to
+//!   back).
 //! - [`doodle`]: `figurine doodle`, a motion-capture take as a figurine pose log;
 //!   [`real_bench`]: `figurine eval real` (recognition on labelled real doodles).
 
@@ -24,6 +25,7 @@ pub mod learn;
 pub mod library;
 pub mod real_bench;
 pub mod regex;
+pub mod repeat_bench;
 pub mod report;
 pub mod rest_bench;
 pub mod separate;

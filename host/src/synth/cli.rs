@@ -10,7 +10,7 @@ use super::gesture::Action;
 use super::knobs::{Knobs, Range};
 use super::rest::{rest_log, RestKind, RestSpec, TrackerLevel};
 use super::sampling::SignMode;
-use super::sequence::{effort_set, examples, gesture, sequence, Doodle};
+use super::sequence::{effort_set, examples, gesture, random_state_for, render, sequence, Doodle};
 
 /// Most actions in one `sequence` log (≈ 2–3 s each; 10 000 actions at 240 Hz ≈ 6 M samples,
 /// ≈ 400 MB in memory).
@@ -57,6 +57,10 @@ enum SynthCommand {
         /// Number of actions.
         #[arg(long, default_value_t = 8)]
         count: usize,
+        /// These actions in this order (comma-separated, e.g. `jump,jump,walk`) instead of
+        /// `--count` random ones; no turn is put in.
+        #[arg(long, value_delimiter = ',')]
+        actions: Vec<Action>,
         /// Effort of every action (default: a random state per action).
         #[arg(long, default_value = "random")]
         effort: OrRandom<Effort>,
@@ -349,16 +353,32 @@ pub fn run(args: SynthArgs) -> Result<()> {
         SynthCommand::Sequence {
             seed,
             count,
+            actions,
             effort,
             out,
             labels,
             knobs,
         } => {
-            if count == 0 || count > MAX_SEQUENCE_ACTIONS {
-                bail!("--count {count}: must be within 1..={MAX_SEQUENCE_ACTIONS}");
+            if count == 0 || count > MAX_SEQUENCE_ACTIONS || actions.len() > MAX_SEQUENCE_ACTIONS {
+                bail!("--count or --actions: must be within 1..={MAX_SEQUENCE_ACTIONS} actions");
             }
             let knobs = knobs.knobs()?;
-            let d = sequence(seed, &knobs, count, effort.0);
+            let d = if actions.is_empty() {
+                sequence(seed, &knobs, count, effort.0)
+            } else {
+                // One effort for all when given, else each action its own random state.
+                let items: Vec<(Action, Effort)> = actions
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &a)| {
+                        let e = effort.0.unwrap_or_else(|| {
+                            random_state_for(crate::synth::sequence::item_seed(seed, i as u64))
+                        });
+                        (a, e)
+                    })
+                    .collect();
+                render(seed, &knobs, &items)
+            };
             write_doodle(&d, &out)?;
             d.write_labels(&labels)
                 .with_context(|| format!("writing {}", labels.display()))?;

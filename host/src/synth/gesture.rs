@@ -79,6 +79,17 @@ impl Action {
         }
     }
 
+    /// `true` for actions that, played again right after themselves, go on rather than
+    /// start anew: each is a few like units already (strides, steps to the side, waves, a
+    /// turn's twists), so more strides are a longer walk, more waving a longer wave. A second
+    /// jump, punch or spin is another action.
+    pub fn continues(self) -> bool {
+        matches!(
+            self,
+            Action::Walk | Action::Run | Action::Sidestep | Action::Wave | Action::Turn
+        )
+    }
+
     /// `true` for actions that move the figurine across the floor.
     pub fn travels(self) -> bool {
         matches!(

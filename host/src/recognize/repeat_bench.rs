@@ -1,0 +1,292 @@
+//! `figurine eval repeat`: one action played several times back to back.
+//!
+//! A child jumps the figurine three times, or punches twice, with no more than a breath between:
+//! that is three jumps, two punches. A walk played on is a longer walk, not several (nor is a
+//! run, steps to the side, a wave or a turn resumed: [`Action::continues`]). Each doodle plays one action 2–4
+//! times in a row with the same effort and a short pause between ([`DEFAULT_PAUSE_S`]); its
+//! truth is one label per repetition, or one label over the whole bout for an action that
+//! continues. Events are matched to labels as `figurine eval` matches sequences (same action,
+//! overlapping; [`pair_events`]). Printed per action: the share of doodles whose events are
+//! exactly the truth (as many events of the action as labels, and nothing else), and how many
+//! events of the action came per doodle against how many were due; then precision, recall and
+//! F1 over all doodles.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use rayon::prelude::*;
+
+use super::eval::{learn_synth_library, pair_events, run_doodle, Ev};
+use super::simulate::load_effort;
+use crate::synth::{self, Action, Knobs, Label, Range};
+
+/// Default pause between repetitions, seconds: a breath, or none to speak of.
+pub const DEFAULT_PAUSE_S: Range = Range { lo: 0.05, hi: 0.4 };
+/// Repetitions per doodle cycle through 2, 3 and 4.
+pub const REPETITIONS: [usize; 3] = [2, 3, 4];
+
+/// Arguments of `figurine eval repeat`.
+#[derive(Args, Debug, Clone)]
+pub struct RepeatArgs {
+    /// Doodles per action and seed pair.
+    #[arg(long, default_value_t = 12)]
+    pub per_action: usize,
+    /// Seed pairs: pair i learns its library at --train-seed + i (3 examples per action) and
+    /// plays its doodles at --seed + 1000·i.
+    #[arg(long, default_value_t = 3)]
+    pub pairs: usize,
+    /// Test seed of the first pair.
+    #[arg(long, default_value_t = 7000)]
+    pub seed: u64,
+    /// Train seed of the first pair.
+    #[arg(long, default_value_t = 1)]
+    pub train_seed: u64,
+    /// Pause between repetitions, seconds: `V` or `LO..HI`.
+    #[arg(long, default_value_t = DEFAULT_PAUSE_S)]
+    pub pause: Range,
+    /// Print every doodle whose events are not exactly its truth.
+    #[arg(long)]
+    pub verbose: bool,
+}
+
+/// One doodle's outcome.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+struct Outcome {
+    /// Labels (events due).
+    due: usize,
+    /// Events of the played action.
+    of_action: usize,
+    /// Events of any other action.
+    other: usize,
+    /// Labels matched by an event.
+    matched: usize,
+}
+
+impl Outcome {
+    fn exact(&self) -> bool {
+        self.of_action == self.due && self.other == 0 && self.matched == self.due
+    }
+}
+
+/// The truth of `n` repetitions of `action`: one label each, or, for an action that
+/// continues, one label over them all.
+fn truth(action: Action, labels: &[Label]) -> Vec<Label> {
+    match (action.continues(), labels.first(), labels.last()) {
+        (true, Some(first), Some(last)) => vec![Label {
+            end: last.end,
+            ..first.clone()
+        }],
+        _ => labels.to_vec(),
+    }
+}
+
+fn outcome(action: Action, truth: &[Label], evs: &[Ev]) -> Outcome {
+    let of_action = evs.iter().filter(|e| e.action == action.name()).count();
+    Outcome {
+        due: truth.len(),
+        of_action,
+        other: evs.len() - of_action,
+        matched: pair_events(truth, evs).iter().flatten().count(),
+    }
+}
+
+/// Outcomes of every doodle of one seed pair, by action (in [`Action::ALL`] order).
+fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<Outcome>>> {
+    let knobs = Knobs {
+        pause_s: args.pause,
+        ..Knobs::default()
+    };
+    let mut lib = learn_synth_library(args.train_seed + pair as u64, 3, &Knobs::default())?;
+    let names = lib.names();
+    let blob = lib.blob()?;
+    let effort = load_effort(None)?;
+    let test_seed = args.seed + 1000 * pair as u64;
+    Action::ALL
+        .iter()
+        .enumerate()
+        .map(|(ai, &action)| {
+            (0..args.per_action)
+                .map(|k| {
+                    let seed = synth::sequence::item_seed(test_seed, (ai * 10_000 + k) as u64);
+                    let n = REPETITIONS[k % REPETITIONS.len()];
+                    let e = synth::sequence::random_state_for(seed);
+                    let d = synth::sequence::render(seed, &knobs, &vec![(action, e); n]);
+                    let t = truth(action, &d.labels);
+                    let evs = run_doodle(&d, &names, &blob, effort)?;
+                    let o = outcome(action, &t, &evs);
+                    if args.verbose && !o.exact() {
+                        let got: Vec<String> = evs
+                            .iter()
+                            .map(|e| format!("{} {:.2}-{:.2}", e.action, e.start, e.end))
+                            .collect();
+                        let due: Vec<String> = t
+                            .iter()
+                            .map(|l| format!("{:.2}-{:.2}", l.start, l.end))
+                            .collect();
+                        let played = vec![action.name(); n].join(",");
+                        eprintln!(
+                            "{action} ×{n}: due [{}], got [{}]\n    figurine synth sequence \
+                             --seed {seed} --actions {played} --effort {} --pause {} \
+                             --out R.csv --labels R.json (library: train seed {})",
+                            due.join(", "),
+                            got.join(", "),
+                            e.name(),
+                            args.pause,
+                            args.train_seed + pair as u64
+                        );
+                    }
+                    Ok(o)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// `figurine eval repeat`.
+pub fn run(args: &RepeatArgs) -> Result<()> {
+    if args.pairs == 0 || args.per_action == 0 {
+        bail!("--pairs and --per-action must be at least 1");
+    }
+    eprintln!(
+        "learning {} libraries and playing {} doodles per action each…",
+        args.pairs, args.per_action
+    );
+    let pairs: Vec<Vec<Vec<Outcome>>> = (0..args.pairs)
+        .into_par_iter()
+        .map(|p| run_pair(args, p))
+        .collect::<Result<_>>()?;
+    println!(
+        "Repetitions: each doodle plays one action {:?} times back to back, pauses {}–{} s \
+         ({} doodles per action over {} seed pairs).",
+        REPETITIONS,
+        args.pause.lo,
+        args.pause.hi,
+        args.per_action * args.pairs,
+        args.pairs
+    );
+    println!(
+        "{:<10} {:<10} {:>7} {:>16} {:>8}",
+        "action", "truth", "exact", "events/doodle", "others"
+    );
+    let mut all = Outcome::default();
+    let (mut exact, mut doodles) = (0usize, 0usize);
+    let mut by_kind = [(0usize, 0usize); 2];
+    for (ai, &action) in Action::ALL.iter().enumerate() {
+        let os: Vec<&Outcome> = pairs.iter().flat_map(|p| &p[ai]).collect();
+        let n = os.len();
+        let ex = os.iter().filter(|o| o.exact()).count();
+        let sum = os.iter().fold(Outcome::default(), |a, o| Outcome {
+            due: a.due + o.due,
+            of_action: a.of_action + o.of_action,
+            other: a.other + o.other,
+            matched: a.matched + o.matched,
+        });
+        println!(
+            "{:<10} {:<10} {:>6.0}% {:>7.2} of {:<6.2} {:>8}",
+            action.name(),
+            if action.continues() {
+                "one bout"
+            } else {
+                "each one"
+            },
+            100.0 * ex as f64 / n.max(1) as f64,
+            sum.of_action as f64 / n.max(1) as f64,
+            sum.due as f64 / n.max(1) as f64,
+            sum.other
+        );
+        let k = &mut by_kind[usize::from(action.continues())];
+        k.0 += ex;
+        k.1 += n;
+        exact += ex;
+        doodles += n;
+        all.due += sum.due;
+        all.of_action += sum.of_action;
+        all.other += sum.other;
+        all.matched += sum.matched;
+    }
+    let events = all.of_action + all.other;
+    let p = all.matched as f64 / events.max(1) as f64;
+    let r = all.matched as f64 / all.due.max(1) as f64;
+    let f1 = if p + r > 0.0 {
+        2.0 * p * r / (p + r)
+    } else {
+        0.0
+    };
+    let share = |(a, b): (usize, usize)| 100.0 * a as f64 / b.max(1) as f64;
+    println!(
+        "exact: {:.1}% of doodles (one-shot actions {:.1}%, continuing ones {:.1}%)",
+        share((exact, doodles)),
+        share(by_kind[0]),
+        share(by_kind[1])
+    );
+    println!(
+        "repeat: precision {:.1}%  recall {:.1}%  F1 {:.1}%",
+        100.0 * p,
+        100.0 * r,
+        100.0 * f1
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{TimeClass, WeightClass};
+
+    fn label(action: &str, start: f64, end: f64) -> Label {
+        Label {
+            action: action.into(),
+            start,
+            end,
+            time_class: TimeClass::Sudden,
+            weight_class: WeightClass::Strong,
+        }
+    }
+
+    fn ev(action: &str, start: f64, end: f64) -> Ev {
+        Ev {
+            action: action.into(),
+            start,
+            end,
+            decided: end,
+            time: 0.0,
+            weight: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_bout_of_a_continuing_action_is_one_label_and_one_shot_repeats_are_each_one() {
+        let played = [label("walk", 1.0, 2.0), label("walk", 2.2, 3.0)];
+        let t = truth(Action::Walk, &played);
+        assert_eq!(t.len(), 1);
+        assert_eq!((t[0].start, t[0].end), (1.0, 3.0));
+        let jumps = [label("jump", 1.0, 2.0), label("jump", 2.2, 3.0)];
+        assert_eq!(truth(Action::Jump, &jumps).len(), 2);
+    }
+
+    #[test]
+    fn merged_split_and_stray_events_are_not_exact() {
+        let jumps = [label("jump", 1.0, 2.0), label("jump", 2.2, 3.0)];
+        let right = [ev("jump", 1.1, 2.0), ev("jump", 2.3, 3.0)];
+        assert!(outcome(Action::Jump, &jumps, &right).exact());
+        // Two jumps reported as one.
+        let merged = outcome(Action::Jump, &jumps, &[ev("jump", 1.0, 3.0)]);
+        assert_eq!((merged.of_action, merged.matched), (1, 1));
+        assert!(!merged.exact());
+        // A stray other action.
+        let stray = [
+            ev("jump", 1.1, 2.0),
+            ev("jump", 2.3, 3.0),
+            ev("crouch", 3.0, 3.2),
+        ];
+        assert!(!outcome(Action::Jump, &jumps, &stray).exact());
+        // A walk split in two.
+        let walk = [label("walk", 1.0, 3.0)];
+        let split = outcome(
+            Action::Walk,
+            &walk,
+            &[ev("walk", 1.0, 2.0), ev("walk", 2.2, 3.0)],
+        );
+        assert_eq!((split.due, split.of_action, split.matched), (1, 2, 1));
+        assert!(!split.exact());
+    }
+}

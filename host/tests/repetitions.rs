@@ -1,0 +1,66 @@
+//! An action played again right after itself: a one-shot action (jump, spin…) gives one event
+//! per performance, a walk played on stays one walk. Generated doodles with a breath (0.1–0.3 s)
+//! between repetitions, recognised with the shipped library. (`figurine eval repeat` measures
+//! every action; a punch whose wind-up is too small to tokenise still runs into the next one.)
+
+use figurine_host::recognize::simulate::{load_effort, load_library, simulate_log};
+use figurine_host::synth::{self, Action, Effort, Knobs, Range};
+
+/// The actions recognised in `n` performances of `action` with `effort`, one doodle per seed.
+fn recognised(
+    action: Action,
+    effort: Effort,
+    n: usize,
+    seeds: std::ops::Range<u64>,
+) -> Vec<Vec<String>> {
+    let knobs = Knobs {
+        pause_s: Range::new(0.1, 0.3),
+        ..Knobs::default()
+    };
+    let (lib, blob) = load_library(None).unwrap();
+    let effort_model = load_effort(None).unwrap();
+    seeds
+        .map(|seed| {
+            let d = synth::sequence::render(seed, &knobs, &vec![(action, effort); n]);
+            simulate_log(&d.log, &lib.names(), &blob, Some(effort_model))
+                .unwrap()
+                .records
+                .into_iter()
+                .map(|r| r.action)
+                .collect()
+        })
+        .collect()
+}
+
+/// How many doodles gave exactly `expected`; prints the others.
+fn exactly(got: &[Vec<String>], expected: &[&str]) -> usize {
+    got.iter()
+        .filter(|g| {
+            let ok = g.iter().map(String::as_str).eq(expected.iter().copied());
+            if !ok {
+                eprintln!("expected {expected:?}, got {g:?}");
+            }
+            ok
+        })
+        .count()
+}
+
+#[test]
+fn two_jumps_with_a_breath_between_are_two_jumps() {
+    let strong = Effort::STATES[0];
+    let got = recognised(Action::Jump, strong, 2, 0..6);
+    // Before one jump's edit budget stopped swallowing the next, most were one event.
+    assert!(exactly(&got, &["jump", "jump"]) >= 5, "{got:?}");
+}
+
+#[test]
+fn three_spins_are_three() {
+    let spins = recognised(Action::Spin, Effort::NEUTRAL, 3, 10..14);
+    assert!(exactly(&spins, &["spin", "spin", "spin"]) >= 3, "{spins:?}");
+}
+
+#[test]
+fn a_walk_played_on_stays_one_walk() {
+    let walks = recognised(Action::Walk, Effort::NEUTRAL, 2, 30..34);
+    assert!(exactly(&walks, &["walk"]) >= 3, "{walks:?}");
+}
