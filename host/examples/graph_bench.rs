@@ -22,9 +22,9 @@ mod engine;
 mod support;
 
 use figurine_host::data::require_data_file;
-use figurine_host::graph::build::{build_graph, BuildParams};
 use figurine_host::graph::plan::DEFAULT_BAND;
 use figurine_host::graph::source::load_clips;
+use figurine_host::graph::{build_graph, BuildParams};
 use figurine_host::graph::{GraphClip, Variant};
 
 const FILES: [&str; 6] = [

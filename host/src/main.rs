@@ -23,14 +23,14 @@ enum Command {
     /// Learn (or replace) an action's pattern from example pose logs.
     Learn(recognize::learn::LearnArgs),
     /// Train the Laban Time/Weight classifiers from labelled one-gesture logs.
-    TrainEffort(recognize::effort_train::TrainEffortArgs),
+    TrainEffort(recognize::report::TrainEffortArgs),
     /// Run the recognizer on a pose log and print the recognised actions.
     Simulate(recognize::simulate::SimulateArgs),
     /// Turn a motion-capture take (BVH or DeepMimic) into a figurine pose log: a real doodle.
     Doodle(recognize::doodle::DoodleArgs),
     /// Evaluate recognition and effort accuracy on synthetic doodles (seed 000 Fig. 7-9);
     /// `eval rest`: false alarms per hour at rest; `eval sweep`: robustness to noise, rate, scale.
-    Eval(recognize::eval::EvalArgs),
+    Eval(recognize::eval_cli::EvalCli),
     /// List serial ports (and, with --probe, the figurines on them).
     Devices(link::cli::DevicesArgs),
     /// Store an action library and effort model on figurines (kept across power cuts).
@@ -69,10 +69,10 @@ fn main() -> anyhow::Result<()> {
         Command::Synth(a) => synth::cli::run(a)?,
         Command::Tokens(a) => recognize::tokens::run(&a)?,
         Command::Learn(a) => recognize::learn::run(&a)?,
-        Command::TrainEffort(a) => recognize::effort_train::run(&a)?,
+        Command::TrainEffort(a) => recognize::report::run(&a)?,
         Command::Simulate(a) => recognize::simulate::run(&a)?,
         Command::Doodle(a) => recognize::doodle::run(&a)?,
-        Command::Eval(a) => recognize::eval::run(&a)?,
+        Command::Eval(a) => recognize::eval_cli::run(&a)?,
         Command::Devices(a) => link::cli::devices(&a)?,
         Command::Upload(a) => link::cli::upload(&a)?,
         Command::Replay(a) => link::cli::replay(&a)?,

@@ -245,7 +245,7 @@ pub fn segment_features(a: &Accum) -> [f32; FEATURES] {
 /// The motion shape of `n` ticks whose |velocity| along the object's left, up and front axes
 /// sums to `sums` and whose world speed sums to `speed`: each as a share of the speed
 /// (floored at [`SPEED_FLOOR`]). What an action's examples and a match are compared by
-/// (`segment::shape_penalty`).
+/// (`shape::shape_penalty`).
 pub fn motion_shape(sums: [f32; 3], speed: f32, n: u32) -> [f32; 3] {
     let speed = fmath::max(speed, SPEED_FLOOR * n as f32);
     sums.map(|s| s / speed)
@@ -447,7 +447,7 @@ mod tests {
             assert!((got - want).abs() < 1e-5, "{s:?}");
         }
         // Nothing added: no shares of a speed that is not there (NaN: no evidence, which
-        // `segment::shape_penalty` charges nothing for), no turn, nothing held, no height.
+        // `shape::shape_penalty` charges nothing for), no turn, nothing held, no height.
         let empty = ShapeSums::new().shape();
         assert!(empty[..3].iter().all(|x| x.is_nan()), "{empty:?}");
         assert_eq!(empty[3..], [0.0, 0.0, 0.0]);

@@ -10,10 +10,10 @@
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
 //! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
 //! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
-//! tokens cost half) → [`segment`] (online decision; stand-alone gestures no action matched
-//! given to their [`nearest`] action; a match right after an event may be its next piece,
-//! its rest or its settling: [`follow`]; a new event only when it went as far as its
-//! action's examples, not a fidget: [`extent`]) →
+//! tokens cost half; a match's motion against its action's: [`shape`]) → [`segment`] (online
+//! decision; stand-alone gestures no action matched given to their [`nearest`] action; a
+//! match right after an event may be its next piece, its rest or its settling: [`follow`]; a
+//! new event only when it went as far as its action's examples, not a fidget: [`extent`]) →
 //! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
@@ -60,6 +60,7 @@ pub mod noise;
 pub mod pattern;
 pub mod recognizer;
 pub mod segment;
+pub mod shape;
 pub mod token;
 
 pub use bayes::EffortModel;

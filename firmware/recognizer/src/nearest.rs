@@ -47,8 +47,8 @@ use crate::automaton::prefix_alive;
 use crate::features::Shape;
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
-use crate::recognizer::{observed_shape, penalty_of};
-use crate::segment::{shape_cost, Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US, SHAPE_CAP};
+use crate::segment::{Candidate, EDIT_SHARE, GAPPED_HOLD_US, HOLD_US};
+use crate::shape::{observed_shape, penalty_of, shape_cost, SHAPE_CAP};
 use crate::token::{Token, STILL};
 
 /// Longest phrase that is compared with the actions, moving tokens; a longer one is no single
@@ -219,7 +219,7 @@ fn closed_reading(
 
 /// Another reading of candidate `c` (its runs `c.start..=c.end`, at most
 /// [`NEAREST_MAX_TOKENS`] moving ones) when its motion shape is as unlike its action's
-/// examples' as [`shape_penalty`](crate::segment::shape_penalty) measures ([`SHAPE_CAP`]):
+/// examples' as [`shape_penalty`](crate::shape::shape_penalty) measures ([`SHAPE_CAP`]):
 /// the action whose pattern reads the same tokens within [`LOOSE_SHARE`] and whose examples'
 /// shape the motion lies within (nearest by cost per aligned token, then the lower index).
 /// None when there is none, or the runs' shape is not that unlike. The automata hold every match
@@ -397,7 +397,7 @@ pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 /// claims it ([`nearest_action`]), as (edits, tokens): any reading that is not mostly edits.
 pub const CLOSED_SHARE: (usize, usize) = (1, 1);
 
-/// Most shape penalty ([`crate::segment::shape_penalty`], quarter tokens) an action may have
+/// Most shape penalty ([`crate::shape::shape_penalty`], quarter tokens) an action may have
 /// for a closed phrase to be read as it, unless every action has more ([`nearest_action`]):
 /// half the cap, so a phrase is never read as an action whose examples moved altogether
 /// otherwise while another's moved about as it did.
@@ -410,8 +410,7 @@ mod tests {
     use crate::alignment::HALF;
     use crate::features::{Accum, Shape, ShapeSums, QUANTITIES, SPEED};
     use crate::pattern::tests::seq_library;
-    use crate::recognizer::shape_of;
-    use crate::segment::shape_cost;
+    use crate::shape::{shape_cost, shape_of};
     use crate::token::parse_token;
 
     /// A history of runs `(token, duration ms)` ("_" for STILL), back to back from t = 0.

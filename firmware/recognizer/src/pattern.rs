@@ -36,7 +36,7 @@
 //! +5  1   share of the time spent still × 255, rounded
 //! +6  1   (1 + mean height above the start as a share of the path length) × 255 / 2, rounded
 //! +7  6   tolerance of each of the six dimensions above, in their order: the largest
-//!         `segment::SHAPE_SCALE`-weighted |example − mean| (at least the learner's floor),
+//!         `shape::SHAPE_SCALE`-weighted |example − mean| (at least the learner's floor),
 //!         × 255 rounded, at most 255
 //! +13 1   the least farthest displacement among the examples (`extent::Extent`), code
 //!         `extent::to_byte` in `extent::MOVED_CODE_UNIT_M`; 0 = not known
@@ -348,7 +348,7 @@ impl<'a> Library<'a> {
     }
 
     /// How far the examples' shapes of action `i` lay from [`Library::shape`], per dimension
-    /// ([`crate::segment::shape_penalty`]'s tolerance: `segment::SHAPE_SCALE`-weighted
+    /// ([`crate::shape::shape_penalty`]'s tolerance: `shape::SHAPE_SCALE`-weighted
     /// |example − mean|, in the shape's units); all 0 when its shape is not known.
     pub fn shape_tolerance(&self, i: usize) -> Shape {
         let mut out = [0.0; SHAPE_DIMS];

@@ -11,7 +11,7 @@ use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
 use crate::extent::{far_enough, span_extent};
-use crate::features::{segment_features, Shape, ShapeSums};
+use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
@@ -19,9 +19,10 @@ use crate::intake::{IntakeCounters, Sample, TICK_S};
 use crate::nearest::{nearest_action, reread, whole_phrase, Nearest, OPEN_PHRASE_US};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
-    edits_fit, shape_cost, shape_penalty, Candidate, Decider, Decision, BRIEF_TURN_RAD,
-    CONTINUE_US, GAPPED_HOLD_US, HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    edits_fit, Candidate, Decider, Decision, BRIEF_TURN_RAD, CONTINUE_US, GAPPED_HOLD_US,
+    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
+use crate::shape::{shape_cost, shape_of};
 use crate::token::{Token, STILL};
 
 /// Most token runs one sample can open: a sample closes at most `MAX_GAP_US / TICK_US` = 25
@@ -688,49 +689,6 @@ fn under_way(
                                 .is_some())
                 })
         })
-}
-
-/// The shape penalty of action `a`'s match over runs `start..=end` ([`shape_penalty`]); None
-/// when the library has no shape for it.
-// Once per candidate, not per sample: one out-of-line copy (flash).
-#[inline(never)]
-pub(crate) fn shape_of(
-    library: &Library<'_>,
-    a: usize,
-    hist: &History,
-    start: u32,
-    end: u32,
-) -> Option<i16> {
-    penalty_of(library, a, &observed_shape(hist, start, end))
-}
-
-/// The shape penalty of action `a` for motion of shape `observed` ([`shape_penalty`]); None
-/// when the library has no shape for it.
-// Once per candidate and per action a match is re-read as: one out-of-line copy (flash).
-#[inline(never)]
-pub(crate) fn penalty_of(library: &Library<'_>, a: usize, observed: &Shape) -> Option<i16> {
-    let expected = library.shape(a)?;
-    Some(shape_penalty(
-        expected,
-        library.shape_tolerance(a),
-        *observed,
-    ))
-}
-
-/// The motion shape of runs `start..=end` ([`Shape`]), the holds between them included.
-pub(crate) fn observed_shape(hist: &History, start: u32, end: u32) -> Shape {
-    let mut sums = ShapeSums::new();
-    let mut i = start;
-    for _ in 0..HISTORY_RUNS {
-        if let Some(r) = hist.get(i) {
-            sums.add(&r.acc, r.token == STILL);
-        }
-        if i == end {
-            break;
-        }
-        i = i.wrapping_add(1);
-    }
-    sums.shape()
 }
 
 #[cfg(test)]

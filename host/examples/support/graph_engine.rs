@@ -10,10 +10,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use figurine_host::graph::build::{build_graph, BuildParams};
 use figurine_host::graph::plan::plan_job;
 use figurine_host::graph::slurm::write_scripts;
 use figurine_host::graph::store::BYTES_PER_FRAME;
+use figurine_host::graph::{build_graph, BuildParams};
 use figurine_host::graph::{cpu_seconds, peak_memory_mib, GraphClip, Variant};
 
 use crate::support::slurm::Cluster;

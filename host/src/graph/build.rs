@@ -16,46 +16,13 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
-use super::graph::{ClipEntry, Edge, MotionGraph, GRAPH_VERSION};
+use super::graph::{BuildParams, ClipEntry, Edge, MotionGraph, GRAPH_VERSION};
 use super::lma::{clip_measurements, MEASUREMENTS};
 use super::search::{all_kernels, search, Found, FrameRows, Layout};
 use super::source::GraphClip;
-use super::style::{
-    gauss_weights, pearson, similarity, ComponentWeights, Standardiser, SMOOTH_HALF,
-};
+use super::style::{gauss_weights, pearson, similarity, Standardiser, SMOOTH_HALF};
 use super::{GraphError, HALF, WINDOW};
-
-/// Parameters of a graph build.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct BuildParams {
-    /// Posture-correlation threshold T_MG ∈ [0, 1] (paper: 0.9).
-    pub t_mg: f32,
-    /// Style-correlation threshold T_LMA ∈ [0, 1] (paper: 0.8).
-    pub t_lma: f32,
-    /// LMA component weights of the style similarity.
-    pub weights: ComponentWeights,
-    /// Minimum distance in frames between two windows of the same clip for a transition.
-    pub min_gap: usize,
-    /// Tile side in windows (memory per tile ≈ 3 × (tile + 36)² × 4 bytes).
-    pub tile: usize,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
-}
-
-impl Default for BuildParams {
-    fn default() -> Self {
-        BuildParams {
-            t_mg: 0.9,
-            t_lma: 0.8,
-            weights: ComponentWeights::default(),
-            min_gap: WINDOW,
-            tile: 256,
-            progress: false,
-        }
-    }
-}
 
 /// Timings and counts of a build, for reports and benchmarks.
 #[derive(Debug, Clone, Default, PartialEq)]

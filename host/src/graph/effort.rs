@@ -292,8 +292,9 @@ pub fn rank_spans_by_effort(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::build::{build_graph, tests::fake_clip, BuildParams};
+    use crate::graph::build::{build_graph, tests::fake_clip};
     use crate::graph::lma::tests::synthetic;
+    use crate::graph::BuildParams;
 
     #[test]
     fn fast_swinging_clip_is_sudden_and_strong() {

@@ -20,10 +20,39 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::build::BuildParams;
 use super::lma::MEASUREMENTS;
-use super::style::Standardiser;
+use super::style::{ComponentWeights, Standardiser};
 use super::{GraphError, WINDOW};
+
+/// Parameters of a graph build.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BuildParams {
+    /// Posture-correlation threshold T_MG ∈ [0, 1] (paper: 0.9).
+    pub t_mg: f32,
+    /// Style-correlation threshold T_LMA ∈ [0, 1] (paper: 0.8).
+    pub t_lma: f32,
+    /// LMA component weights of the style similarity.
+    pub weights: ComponentWeights,
+    /// Minimum distance in frames between two windows of the same clip for a transition.
+    pub min_gap: usize,
+    /// Tile side in windows (memory per tile ≈ 3 × (tile + 36)² × 4 bytes).
+    pub tile: usize,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for BuildParams {
+    fn default() -> Self {
+        BuildParams {
+            t_mg: 0.9,
+            t_lma: 0.8,
+            weights: ComponentWeights::default(),
+            min_gap: WINDOW,
+            tile: 256,
+            progress: false,
+        }
+    }
+}
 
 /// Magic bytes at the start of a graph file.
 pub const MAGIC: &[u8; 8] = b"FIGGRAPH";

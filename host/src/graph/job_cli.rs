@@ -5,8 +5,8 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::cli::{load, BuildOpts};
 use super::graph::Variant;
+use super::inputs::{load, BuildOpts};
 use super::merge::merge_job;
 use super::plan::{plan_job, DEFAULT_BAND};
 use super::slurm::{write_scripts, DEFAULT_MAX_ARRAY_INDEX};

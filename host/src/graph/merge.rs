@@ -106,10 +106,11 @@ pub fn merge_job(job: &Path) -> Result<(MotionGraph, MergeStats), GraphError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::build::{build_graph, tests::fake_clip, BuildParams};
+    use crate::graph::build::{build_graph, tests::fake_clip};
     use crate::graph::lma::tests::synthetic;
     use crate::graph::plan::{plan_job, MANIFEST_FILE};
     use crate::graph::tile::{encode_tile, parse_tile, run_tile};
+    use crate::graph::BuildParams;
 
     fn job(name: &str) -> std::path::PathBuf {
         let d = std::env::temp_dir().join(format!("figurine-merge-{}-{name}", std::process::id()));

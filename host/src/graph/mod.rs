@@ -17,7 +17,8 @@
 //! - [`effort`]: Laban Effort (Lt, Lw) from the Effort-component measurements, for choosing
 //!   clip variants and transitions by a recognised effort.
 //! - [`eval`]: the paper's §5.2–5.3 evaluation (label costs, transition counts).
-//! - [`cli`]: `figurine graph build | synth | eval`; `job_cli`: `figurine graph plan | tile | merge`.
+//! - [`cli`]: `figurine graph build | synth | eval`; `job_cli`: `figurine graph plan | tile | merge`;
+//!   [`inputs`]: the clips and build options both take.
 
 use std::path::PathBuf;
 
@@ -29,6 +30,7 @@ pub mod effort;
 pub mod eval;
 #[allow(clippy::module_inception)]
 pub mod graph;
+pub mod inputs;
 mod job_cli;
 pub mod lma;
 pub mod merge;
@@ -43,7 +45,8 @@ pub mod style;
 pub mod synth;
 pub mod tile;
 
-pub use build::{build_graph, BuildParams};
+pub use build::build_graph;
+pub use graph::BuildParams;
 pub use graph::{Edge, MotionGraph, Variant};
 pub use roles::{Role, RoleMap};
 pub use source::{load_clip, GraphClip};

@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::build::{check_clips, clip_entries, measurements, BuildParams};
+use super::build::{check_clips, clip_entries, measurements};
+use super::graph::BuildParams;
 use super::graph::ClipEntry;
 use super::search::{kernel_side, FrameRows};
 use super::source::GraphClip;

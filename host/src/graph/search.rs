@@ -26,7 +26,7 @@ use ndarray::linalg::general_mat_mul;
 use ndarray::{ArrayView2, ArrayViewMut2};
 use rayon::prelude::*;
 
-use super::build::BuildParams;
+use super::graph::BuildParams;
 use super::posture::{window_terms, WindowTerms, POINTS};
 use super::roles::Role;
 use super::source::GraphClip;

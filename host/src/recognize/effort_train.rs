@@ -1,4 +1,5 @@
-//! `figurine train-effort`: Laban Time/Weight classifiers from labelled one-gesture logs.
+//! Laban Time/Weight classifiers from labelled one-gesture logs (`figurine train-effort`, whose
+//! command and report are in [`super::report`]).
 //!
 //! DIR holds `sudden-strong/`, `sudden-light/`, `sustained-strong/`, `sustained-light/` with
 //! one-gesture pose logs. Each log's 58 features are computed by the device front end over the
@@ -15,13 +16,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
 use figurine_recognizer::bayes::{MAX_EFFORT_FEATURES, MIN_VARIANCE};
 use figurine_recognizer::features::{segment_features, FEATURES};
 
 use super::effort_model::{feature_name, AxisFile, ClassifierKind, EffortFile, FeatureParams};
 use super::feed::gesture_accum;
-use super::report;
 use crate::poselog::PoseLog;
 
 /// The four state folders, in (time, weight) order: (+,+), (+,−), (−,+), (−,−).
@@ -39,16 +38,6 @@ pub const VAR_FLOOR: f32 = 1e-3;
 /// each feature's own variance (the features are standardised first): keeps the solve stable
 /// when selected features are nearly collinear (a mean and its spread).
 pub const RIDGE: f64 = 0.1;
-
-/// Arguments of `figurine train-effort`.
-#[derive(Args, Debug)]
-pub struct TrainEffortArgs {
-    /// Output model (EFFORT.json); a PNG report is written next to it (EFFORT.png).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Folder with the four state sub-folders of one-gesture logs.
-    pub dir: PathBuf,
-}
 
 /// One labelled example: features and (sudden?, strong?).
 #[derive(Debug, Clone)]
@@ -390,60 +379,6 @@ pub fn read_dir(dir: &Path) -> Result<Vec<Example>> {
         }
     }
     Ok(out)
-}
-
-/// `figurine train-effort`.
-pub fn run(args: &TrainEffortArgs) -> Result<()> {
-    let ex = read_dir(&args.dir)?;
-    let t = train(&ex).with_context(|| format!("training from {}", args.dir.display()))?;
-    t.file.write(&args.out)?;
-    for (a, (name, ax)) in [("Time", &t.file.time), ("Weight", &t.file.weight)]
-        .iter()
-        .enumerate()
-    {
-        println!(
-            "{name}: {} with {} features, cross-validated accuracy {:.1}% (best naive Bayes \
-             {:.1}%, linear {:.1}%; M=1..{}: {})",
-            match ax.classifier {
-                ClassifierKind::NaiveBayes => "naive Bayes",
-                ClassifierKind::Linear => "linear discriminant",
-            },
-            ax.features.len(),
-            100.0 * ax.cv_accuracy.unwrap_or(0.0),
-            100.0 * t.best_of[a].0,
-            100.0 * t.best_of[a].1,
-            MAX_EFFORT_FEATURES,
-            t.curves[a]
-                .iter()
-                .map(|c| format!("{:.0}", 100.0 * c))
-                .collect::<Vec<_>>()
-                .join(" ")
-        );
-        for f in &ax.features {
-            println!(
-                "  {:>2} {:<24} ratio {:.3}",
-                f.index,
-                f.name,
-                t.relevance[a][usize::from(f.index)]
-            );
-        }
-    }
-    let state_ok = ex
-        .iter()
-        .enumerate()
-        .filter(|(i, e)| {
-            (t.cv_pred[0][*i] > 0.0) == e.sudden && (t.cv_pred[1][*i] > 0.0) == e.strong
-        })
-        .count();
-    println!(
-        "state (both axes) cross-validated accuracy {:.1}% over {} examples",
-        100.0 * state_ok as f64 / ex.len() as f64,
-        ex.len()
-    );
-    let png = args.out.with_extension("png");
-    report::effort_report(&png, &ex, &t)?;
-    println!("wrote {} and {}", args.out.display(), png.display());
-    Ok(())
 }
 
 #[cfg(test)]

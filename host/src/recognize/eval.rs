@@ -19,21 +19,18 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::{Args, Subcommand};
+use clap::Args;
 
 use super::effort_train::{gesture_features, train, Example, Trained};
 use super::feed::{log_samples, recognize_log, Clock};
 use super::learn::learn_action;
 use super::library::LibraryFile;
-use super::rest_bench::RestBenchArgs;
 use super::simulate::load_effort;
-use super::sweep::SweepArgs;
 use crate::synth::{self, Action, Doodle, Knobs, Label, Range, TimeClass, WeightClass};
 use figurine_recognizer::{EffortModel, Library, Recognizer};
 
-/// Arguments of `figurine eval`.
+/// Arguments of `figurine eval` (the accuracy tables).
 #[derive(Args, Debug)]
-#[command(args_conflicts_with_subcommands = true)]
 pub struct EvalArgs {
     /// Seed of the test set (use one nothing was trained on).
     #[arg(long, default_value_t = 1000)]
@@ -87,26 +84,6 @@ pub struct EvalArgs {
     /// Spatial scale of the doodles (default 0.5..2; at 1 a gesture is about 14 cm across).
     #[arg(long)]
     pub scale: Option<Range>,
-    /// A benchmark instead of the accuracy tables.
-    #[command(subcommand)]
-    pub command: Option<EvalCommand>,
-}
-
-/// The benchmarks of `figurine eval`.
-#[derive(Subcommand, Debug, Clone)]
-pub enum EvalCommand {
-    /// False alarms per hour at rest: hours of a figurine held, set down or mounted, under
-    /// every tracker level, with the shipped library and libraries learnt from 3 examples.
-    Rest(RestBenchArgs),
-    /// Robustness: isolated accuracy and sequence F1 as the tracker's noise, its rate or the
-    /// doodle's scale is swept.
-    Sweep(SweepArgs),
-    /// Real doodles: motion-capture takes of people turned into figurine logs and labelled
-    /// by hand (`host/assets/real_takes.json`), recognised; recall and precision.
-    Real(super::real_bench::RealBenchArgs),
-    /// Repetitions: one action played 2–4 times back to back is as many events (one for a
-    /// walk, run, sidestep, wave or turn played on).
-    Repeat(super::repeat_bench::RepeatArgs),
 }
 
 impl EvalArgs {
@@ -514,21 +491,8 @@ pub fn prepare(args: &EvalArgs, knobs: &Knobs) -> Result<(LibraryFile, EffortMod
     Ok((lib, effort))
 }
 
-/// `figurine eval`.
+/// `figurine eval` with one seed pair: prints the accuracy tables.
 pub fn run(args: &EvalArgs) -> Result<()> {
-    match &args.command {
-        Some(EvalCommand::Rest(a)) => return super::rest_bench::run(a),
-        Some(EvalCommand::Sweep(a)) => return super::sweep::run(a),
-        Some(EvalCommand::Real(a)) => return super::real_bench::run(a),
-        Some(EvalCommand::Repeat(a)) => return super::repeat_bench::run(a),
-        None => {}
-    }
-    if args.pairs == 0 {
-        anyhow::bail!("--pairs must be at least 1");
-    }
-    if args.pairs > 1 {
-        return super::eval_pairs::run(args);
-    }
     let knobs = args.knobs();
     let (mut lib, effort) = prepare(args, &knobs)?;
     let f = evaluate(args, &mut lib, effort, &knobs)?;

@@ -97,7 +97,6 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             effort: None,
             save_library: None,
             save_effort: None,
-            command: None,
             ..*args
         };
         let (mut lib, effort) = prepare(&pair, &knobs)?;

@@ -32,21 +32,20 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::alignment::FULL;
-use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::extent::{Extent, ExtentSums};
 use figurine_recognizer::features::{Accum, Shape, ShapeSums, ANGVEL, SPEED};
 use figurine_recognizer::history::Run;
-use figurine_recognizer::pattern::{MAX_ACTIONS, MAX_POSITIONS};
-use figurine_recognizer::segment::{edits_fit, SHAPE_SCALE};
+use figurine_recognizer::pattern::MAX_POSITIONS;
+use figurine_recognizer::segment::edits_fit;
+use figurine_recognizer::shape::SHAPE_SCALE;
 use figurine_recognizer::token::{
     mirror_token, symbol_matches, token_from_signs, token_signs, Symbol, Token, ANY_LIN, ANY_ROT,
     NONE_BIN, STILL, TURN,
 };
-use figurine_recognizer::Library;
 
 use super::dtw;
 use super::feed::{gesture_runs, log_gesture, log_runs, log_samples};
-use super::library::{parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
+use super::library::{full_match, parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
 use super::regex::{default_edits, Regex};
 use crate::poselog::PoseLog;
 
@@ -120,7 +119,7 @@ fn run_seconds(r: &Run) -> f64 {
 
 /// The motion shape of a one-performance log's gesture, from its first to its last motion
 /// (`figurine_recognizer::features::Shape`) — what the device measures over a match
-/// (`figurine_recognizer::segment::shape_penalty`). None without motion.
+/// (`figurine_recognizer::shape::shape_penalty`). None without motion.
 pub fn motion_shape(log: &PoseLog) -> Option<Shape> {
     shape_of_runs(&log_gesture(log))
 }
@@ -173,7 +172,7 @@ pub const SHAPE_TOLERANCE_FLOOR: f32 = 0.06;
 
 /// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the largest
 /// |shape − mean|, weighted by `SHAPE_SCALE` as the device weighs it
-/// (`figurine_recognizer::segment::shape_penalty`), at least [`SHAPE_TOLERANCE_FLOOR`].
+/// (`figurine_recognizer::shape::shape_penalty`), at least [`SHAPE_TOLERANCE_FLOOR`].
 /// None without shapes.
 pub fn shape_tolerance(shapes: &[Shape]) -> Option<Shape> {
     let mean = mean_shape(shapes)?;
@@ -829,35 +828,6 @@ pub fn compact_rotations(re: &Regex) -> Regex {
         Regex::Opt(r) => Regex::Opt(Box::new(compact_rotations(r))),
         Regex::Sym(s) => Regex::Sym(*s),
     }
-}
-
-/// Cost in half-edits (a near substitution costs one, other edits two) of the best match of
-/// `entry`'s pattern covering all of `tokens`, if within its bound.
-pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
-    let mut one = LibraryFile::default();
-    one.actions.push(entry.clone());
-    let blob = one.blob()?;
-    let lib = Library::from_bytes(&blob).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let Some(p) = lib.pattern(0) else {
-        return Ok(None);
-    };
-    let mut bank = MatcherBank::new();
-    let mut m = [u8::MAX; MAX_ACTIONS];
-    for &t in tokens {
-        bank.step(&lib, t, &mut m);
-    }
-    if m[0] == u8::MAX {
-        return Ok(None);
-    }
-    let back = |j: usize| tokens.len().checked_sub(j + 1).map(|i| tokens[i]);
-    for cost in m[0]..=FULL * entry.max_edits {
-        if let Some((j, k)) = earliest_start(&p, cost, back) {
-            if j + 1 == tokens.len() {
-                return Ok(Some(k));
-            }
-        }
-    }
-    Ok(None)
 }
 
 /// Which examples to mirror so that all are performed to the side of the median-length one:

@@ -10,6 +10,8 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use figurine_recognizer::alignment::FULL;
+use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::extent::{to_byte, Extent, MOVED_CODE_UNIT_M, TURNED_CODE_UNIT_RAD};
 use figurine_recognizer::features::Shape;
 use figurine_recognizer::pattern::{
@@ -340,6 +342,35 @@ impl LibraryFile {
             self.actions.len() - 1
         }
     }
+}
+
+/// Cost in half-edits (a near substitution costs one, other edits two) of the best match of
+/// `entry`'s pattern covering all of `tokens`, if within its bound.
+pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
+    let mut one = LibraryFile::default();
+    one.actions.push(entry.clone());
+    let blob = one.blob()?;
+    let lib = Library::from_bytes(&blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let Some(p) = lib.pattern(0) else {
+        return Ok(None);
+    };
+    let mut bank = MatcherBank::new();
+    let mut m = [u8::MAX; MAX_ACTIONS];
+    for &t in tokens {
+        bank.step(&lib, t, &mut m);
+    }
+    if m[0] == u8::MAX {
+        return Ok(None);
+    }
+    let back = |j: usize| tokens.len().checked_sub(j + 1).map(|i| tokens[i]);
+    for cost in m[0]..=FULL * entry.max_edits {
+        if let Some((j, k)) = earliest_start(&p, cost, back) {
+            if j + 1 == tokens.len() {
+                return Ok(Some(k));
+            }
+        }
+    }
+    Ok(None)
 }
 
 #[cfg(test)]

@@ -7,7 +7,8 @@
 //! - [`dtw`] + [`learn`] + [`separate`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ `font`): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
-//! - [`eval`] (+ [`eval_pairs`]): `figurine eval`; [`rest_bench`]: `figurine eval rest` (false
+//! - [`eval_cli`]: `figurine eval`, the accuracy tables of [`eval`] (+ [`eval_pairs`]) or a
+//!   benchmark: [`rest_bench`]: `figurine eval rest` (false
 //!   alarms per hour at rest); [`sweep`]: `figurine eval sweep` (robustness to noise, rate,
 //!   scale); [`repeat_bench`]: `figurine eval repeat` (one action played several times back to
 //!   back).
@@ -19,6 +20,7 @@ pub mod dtw;
 pub mod effort_model;
 pub mod effort_train;
 pub mod eval;
+pub mod eval_cli;
 pub mod eval_pairs;
 pub mod feed;
 pub mod learn;

@@ -1,14 +1,18 @@
-//! The PNG report of `figurine train-effort`: feature ranking, selection curves, confusion
-//! matrices.
+//! `figurine train-effort` and its report: the model trained ([`super::effort_train`]), what
+//! it prints (each axis's classifier, features and cross-validated accuracy) and its PNG
+//! (feature ranking, selection curves, confusion matrices).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use clap::Args;
+use figurine_recognizer::bayes::MAX_EFFORT_FEATURES;
 use figurine_recognizer::features::FEATURES;
 use image::{Rgb, RgbImage};
 
 use super::effort_model::ClassifierKind;
-use super::effort_train::{Example, Trained};
+use super::effort_train::{read_dir, train, Example, Trained};
+use crate::raster::{draw_text, fill_rect, line};
 
 /// Short name of a classifier for the report.
 fn classifier(k: ClassifierKind) -> &'static str {
@@ -17,7 +21,6 @@ fn classifier(k: ClassifierKind) -> &'static str {
         ClassifierKind::Linear => "LDA",
     }
 }
-use crate::raster::{draw_text, fill_rect, line};
 
 const W: u32 = 960;
 const H: u32 = 720;
@@ -260,5 +263,68 @@ pub fn effort_report(path: &Path, ex: &[Example], t: &Trained) -> Result<()> {
     );
     img.save(path)
         .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+/// Arguments of `figurine train-effort`.
+#[derive(Args, Debug)]
+pub struct TrainEffortArgs {
+    /// Output model (EFFORT.json); a PNG report is written next to it (EFFORT.png).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Folder with the four state sub-folders of one-gesture logs.
+    pub dir: PathBuf,
+}
+
+/// `figurine train-effort`.
+pub fn run(args: &TrainEffortArgs) -> Result<()> {
+    let ex = read_dir(&args.dir)?;
+    let t = train(&ex).with_context(|| format!("training from {}", args.dir.display()))?;
+    t.file.write(&args.out)?;
+    for (a, (name, ax)) in [("Time", &t.file.time), ("Weight", &t.file.weight)]
+        .iter()
+        .enumerate()
+    {
+        println!(
+            "{name}: {} with {} features, cross-validated accuracy {:.1}% (best naive Bayes \
+             {:.1}%, linear {:.1}%; M=1..{}: {})",
+            match ax.classifier {
+                ClassifierKind::NaiveBayes => "naive Bayes",
+                ClassifierKind::Linear => "linear discriminant",
+            },
+            ax.features.len(),
+            100.0 * ax.cv_accuracy.unwrap_or(0.0),
+            100.0 * t.best_of[a].0,
+            100.0 * t.best_of[a].1,
+            MAX_EFFORT_FEATURES,
+            t.curves[a]
+                .iter()
+                .map(|c| format!("{:.0}", 100.0 * c))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+        for f in &ax.features {
+            println!(
+                "  {:>2} {:<24} ratio {:.3}",
+                f.index,
+                f.name,
+                t.relevance[a][usize::from(f.index)]
+            );
+        }
+    }
+    let state_ok = ex
+        .iter()
+        .enumerate()
+        .filter(|(i, e)| {
+            (t.cv_pred[0][*i] > 0.0) == e.sudden && (t.cv_pred[1][*i] > 0.0) == e.strong
+        })
+        .count();
+    println!(
+        "state (both axes) cross-validated accuracy {:.1}% over {} examples",
+        100.0 * state_ok as f64 / ex.len() as f64,
+        ex.len()
+    );
+    let png = args.out.with_extension("png");
+    effort_report(&png, &ex, &t)?;
+    println!("wrote {} and {}", args.out.display(), png.display());
     Ok(())
 }

@@ -37,8 +37,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use anyhow::Result;
 use figurine_recognizer::token::{Symbol, ANY_LIN, ANY_ROT, NONE_BIN};
 
-use super::learn::full_match;
-use super::library::{parse_tokens, ActionEntry, LibraryFile};
+use super::library::{full_match, parse_tokens, ActionEntry, LibraryFile};
 use super::regex::Regex;
 
 /// Narrowing steps [`separate`] takes at most over a whole library.

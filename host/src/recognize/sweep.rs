@@ -155,7 +155,6 @@ impl Axis {
             noise: if self == Axis::Noise { pin } else { None },
             rate: if self == Axis::Rate { pin } else { None },
             scale: if self == Axis::Scale { pin } else { None },
-            command: None,
         }
     }
 }

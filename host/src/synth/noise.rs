@@ -198,6 +198,13 @@ impl Glitcher {
     }
 }
 
+/// Peak per axis of a set of partials (the largest axis sum of amplitudes).
+pub(super) fn peak<const N: usize>(ps: &[[Partial; N]; 3]) -> f64 {
+    ps.iter()
+        .map(|a| a.iter().map(|p| p.amp.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

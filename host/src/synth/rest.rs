@@ -25,7 +25,7 @@ use glam::{DQuat, DVec3};
 use serde::Serialize;
 
 use super::knobs::{Knobs, Range};
-use super::noise::{eval3, partials, Partial};
+use super::noise::{eval3, partials, peak, Partial};
 use super::rng::{Stream, SynthRng};
 use super::sampling::{sample_times, SignPolicy, MAX_RATE_HZ, MIN_RATE_HZ};
 use super::sequence::to_micros;
@@ -333,13 +333,6 @@ struct RestMotion {
     fidgets: Vec<Fidget>,
     /// Peaks for [`RestInfo`]: tremor m, tremor rad, sway m, sway rad, vibration m, vibration Hz.
     peaks: [f64; 6],
-}
-
-/// Peak per axis of a set of partials (the largest axis sum of amplitudes).
-pub(super) fn peak<const N: usize>(ps: &[[Partial; N]; 3]) -> f64 {
-    ps.iter()
-        .map(|a| a.iter().map(|p| p.amp.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 impl RestMotion {

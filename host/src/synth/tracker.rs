@@ -7,8 +7,8 @@ use std::f64::consts::TAU;
 use glam::{DQuat, DVec3};
 
 use super::knobs::Range;
+use super::noise::peak;
 use super::noise::{eval3, partials, Partial};
-use super::rest::peak;
 use super::rng::SynthRng;
 
 /// A class of real tracker: its noise, drift and sample rate. Position σ is per axis; a tracker
