@@ -63,6 +63,9 @@ pub fn bench() -> Result<()> {
     step("recognition on real doodles (people's motion capture): figurine eval real");
     figurine(&["eval", "real"])?;
 
+    step("one action played several times back to back: figurine eval repeat");
+    figurine(&["eval", "repeat"])?;
+
     step(
         "animation plausibility against real motion capture: figurine check --reference --defaults",
     );

@@ -20,7 +20,7 @@ use crate::nearest::{nearest_action, reread, whole_phrase, Nearest, OPEN_PHRASE_
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, Candidate, Decider, Decision, BRIEF_TURN_RAD, CONTINUE_US, GAPPED_HOLD_US,
-    HOLD_BACK_TOKENS, LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
+    LONG_PAUSE_US, MIN_ACTION_US, PAUSE_US,
 };
 use crate::shape::{shape_cost, shape_of};
 use crate::token::{Token, STILL};
@@ -283,8 +283,7 @@ impl<'lib> Recognizer<'lib> {
         }
     }
 
-    /// Whether another action's match began with `p` (its own first part skipped) or, exactly,
-    /// up to [`HOLD_BACK_TOKENS`] tokens before `p` (so it covers `p` and more) and is still
+    /// Whether another action's match began with `p` (its own first part skipped) and is still
     /// under way: then a pause after `p` is a hold inside that longer gesture — a punch held at
     /// full reach after its forward stroke. When `p` needed a whole edit, a match under way
     /// that is not exact but costs less than `p` ([`prefix_cost`]) counts too, begun with `p`
@@ -328,11 +327,10 @@ impl<'lib> Recognizer<'lib> {
             let tokens = moving.get(from..).unwrap_or(&[]);
             under_way(&self.library, p.action, tokens, skip_first, tolerance)
         };
-        // Begun with the pending candidate, but without its own first part, or exactly a
-        // little earlier; or, tolerantly, with it or one token into it.
+        // Begun with the pending candidate, but without its own first part; or, tolerantly,
+        // with it or one token into it.
         alive_from(ps, true)
             || (tolerance > 0 && (alive_from(ps, false) || alive_from(ps + 1, false)))
-            || (1..=HOLD_BACK_TOKENS.min(ps)).any(|back| alive_from(ps - back, false))
     }
 
     fn emit_held(&mut self, h: Held, revises: bool, emit: &mut impl FnMut(ActionEvent)) {

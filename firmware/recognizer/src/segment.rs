@@ -73,8 +73,6 @@ pub const MIN_ACTION_US: u64 = 150_000;
 /// rad (the turning about the three object axes summed): a quarter turn. A flicker does not
 /// turn the figurine that far; a sudden turn does, in little more than a tenth of a second.
 pub const BRIEF_TURN_RAD: f32 = core::f32::consts::FRAC_PI_2;
-/// Moving runs before a pending candidate where a longer action in progress may have begun.
-pub const HOLD_BACK_TOKENS: usize = 2;
 /// Stillness that forgets all partial matches, µs (unrelated gestures are not joined).
 pub const LONG_PAUSE_US: u64 = 2_500_000;
 
