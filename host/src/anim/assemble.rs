@@ -51,6 +51,17 @@ use crate::poselog::PoseLog;
 /// Fastest playback of a clip relative to its own speed (before effort retiming).
 pub const MAX_SPEEDUP: f32 = 3.0;
 
+/// How many times more (or fewer) steps a gait may take per second than its clip does. People
+/// walk at about 70–140 steps a minute and run at 150–230 (a sprint), about 1.5× either side
+/// of an everyday pace; beyond it a walk would turn into a run, a run into a shuffle.
+pub const MAX_CADENCE: f32 = 1.5;
+
+/// The fastest a character's root may move, m/s: the fastest real take the project fetches
+/// (DeepMimic's run, 4.2 m/s), the same limit `figurine check` judges against
+/// ([`super::check::envelope::ROOT_SPEED_M_S`]). No person's hips outrun it; an action that
+/// would is given more time.
+pub const HUMAN_ROOT_SPEED_M_S: f32 = super::check::envelope::ROOT_SPEED_M_S;
+
 /// Most frames an assembled animation may have (two hours at 30 fps; ≈ 360 MB of poses for a
 /// 60-joint rig): events whose times span more are refused rather than exhausting memory.
 pub const MAX_OUTPUT_FRAMES: usize = 216_000;
@@ -169,6 +180,7 @@ impl Placed {
 }
 
 /// Character state carried from one action to the next.
+#[derive(Clone)]
 struct Cursor {
     pos: Vec2,
     heading: Vec2,
@@ -303,27 +315,59 @@ pub fn assemble_guided(
             })
             .clone();
         let applied = residual_effort(effort, variant.as_ref());
-        let ec = apply_effort(&ac.clip, &phrasing, applied, forward, ac.cyclic);
-        let chunk = match &path {
+        let ec = apply_effort(
+            &ac.clip,
+            &phrasing,
+            applied,
+            forward,
+            ac.cyclic,
+            ac.ranges.as_deref(),
+        );
+        let doodled = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
             None => natural_path(ac, (ev.end - ev.start) as f32),
         };
+        let (chunk, cycles) = pace(ac, &ec, &doodled, (ev.end - ev.start) as f32);
         // Never faster than MAX_SPEEDUP × the clip (all its cycles): a too-short event overruns
         // into the pause after it (the next action waits if it must).
-        let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
         let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
-        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
-        if f1 > MAX_OUTPUT_FRAMES {
-            return Err(AnimError::Data(format!(
-                "action {} at {} s would end at frame {f1}, past the {MAX_OUTPUT_FRAMES} frames \
-                 an animation may have",
-                ev.action, ev.start
-            )));
+        let mut f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        // Nor does any stretch of it move the root faster than a person: the time map gives
+        // such stretches the time they need (see `EffortClip::paced`), per cycle.
+        let (ec, cycle_s) = ec.paced(
+            (f1 - f0) as f32 / fps / cycles.max(1) as f32,
+            HUMAN_ROOT_SPEED_M_S,
+        );
+        f1 = f1.max(f0 + (cycle_s * cycles.max(1) as f32 * fps).ceil() as usize);
+        // Nor faster than a person moves: an action whose root would outrun
+        // HUMAN_ROOT_SPEED_M_S (a short event squeezing a long clip, a sudden retime
+        // compressing a lunge) takes the time it needs, its timing slowed evenly — but never
+        // beyond the clip's own pace (or the event's length, if longer): what is still too
+        // fast then is no matter of timing.
+        let slowest = f1.max(f0 + (cycles as f32 * ac.clip.duration() * fps).ceil() as usize);
+        let start = cursor.clone();
+        let mut placed_action;
+        loop {
+            if f1 > MAX_OUTPUT_FRAMES {
+                return Err(AnimError::Data(format!(
+                    "action {} at {} s would end at frame {f1}, past the {MAX_OUTPUT_FRAMES} \
+                     frames an animation may have",
+                    ev.action, ev.start
+                )));
+            }
+            cursor = start.clone();
+            placed_action = place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+            let fastest = root_speed_max(&placed_action.0, 1.0 / fps);
+            if fastest <= HUMAN_ROOT_SPEED_M_S || f1 >= slowest {
+                break;
+            }
+            let n = (f1 - f0) as f32;
+            let need = (n * fastest / HUMAN_ROOT_SPEED_M_S).ceil().max(n + 1.0) as usize;
+            f1 = (f0 + need).min(slowest);
         }
         let duration = (f1 - f0) as f32 / fps;
-        let (poses, world_path, cycles, src_times) =
-            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+        let (poses, world_path, cycles, src_times) = placed_action;
         let src_contacts = source_contacts
             .entry(key)
             .or_insert_with(|| detect_contacts(&ac.clip, &legs))
@@ -701,26 +745,66 @@ fn place_action(
     (poses, world_path, cycles, src_times)
 }
 
-/// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
-/// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
-/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put). A looping clip that
-/// plays in place (or a cyclic one without a path to follow) repeats as many whole times as
-/// fill the duration at its own speed. 1 otherwise (moving, non-cyclic actions play once).
-fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
+/// The path a moving action covers in `duration` seconds and the cycles it plays on it, at a
+/// pace a person keeps.
+///
+/// - **Cyclic** (walk, run): a stride stays tied to the distance it covers, and steps come
+///   no more than [`MAX_CADENCE`] times as often as in the clip, nor less than 1/[`MAX_CADENCE`]
+///   as often. Whole cycles of the (effort-rescaled) clip's travel are fitted to the path
+///   within that range of cadence; a path too short for it gets more, shorter steps (a slow
+///   run steps short, the stretched-down root and the foot pinning keep the feet planted); a
+///   path too long for it — the doodle's pace times the world scale beyond what the action's
+///   longest stride at its quickest cadence covers — is shrunk, about its start, to what that
+///   pace covers in the time (its shape kept). The doodle's world scale thus says how big the
+///   path is wherever a person can cover it, and the animation keeps the doodle's timing; a
+///   character does not sprint 7 m/s because a toy was swept fast across a table.
+/// - **Not cyclic** (jump): the path is shrunk to at most the (effort-rescaled) clip's own
+///   travel: a jump lands where its take-off carries it.
+/// - **In place**: a looping clip repeats as many whole times as fill the duration at its
+///   own speed (so does a cyclic clip without a path); else 1.
+fn pace(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> (Polyline, usize) {
     let root = ec.clip.root_path();
-    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
-        return 1;
+    let travel = match (root.first(), root.last()) {
+        (Some(&r0), Some(&rl)) => ground(rl - r0).length(),
+        _ => 0.0,
     };
-    let cycle_len = ground(rl - r0).length();
-    if ac.cyclic && ac.moving && chunk.length() > 0.05 && cycle_len > 0.05 {
-        let by_path = (chunk.length() / cycle_len).round() as usize;
-        let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
-        by_path.min(by_time).max(1)
+    let cycle_s = ec.clip.duration().max(1e-3);
+    let len = chunk.length();
+    if ac.moving && ac.cyclic && len > 0.05 && travel > 0.05 && duration.is_finite() {
+        // Cycles at the quickest and slowest cadence that fill the duration.
+        let most = ((duration * MAX_CADENCE / cycle_s).floor() as usize).max(1);
+        let least = ((duration / (MAX_CADENCE * cycle_s)).ceil() as usize).clamp(1, most);
+        let by_path = (len / travel).round() as usize;
+        let cycles = by_path.clamp(least, most);
+        let reach = cycles as f32 * travel;
+        (shrink(chunk, reach), cycles)
+    } else if ac.moving && !ac.cyclic && len > 0.05 {
+        (shrink(chunk, travel.max(0.05)), 1)
     } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {
-        (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
+        let cycles = (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize;
+        (chunk.clone(), cycles)
     } else {
-        1
+        (chunk.clone(), 1)
     }
+}
+
+/// `chunk` (starting at the origin) scaled about its start to at most `most` metres long.
+fn shrink(chunk: &Polyline, most: f32) -> Polyline {
+    let len = chunk.length();
+    if len <= most || len <= 0.0 {
+        return chunk.clone();
+    }
+    let f = most / len;
+    Polyline::new(chunk.pts.iter().map(|p| *p * f).collect())
+}
+
+/// The fastest the root of `poses` moves from one frame to the next, m/s.
+fn root_speed_max(poses: &[Pose], dt: f32) -> f32 {
+    poses
+        .windows(2)
+        .map(|w| (w[1].translations[0] - w[0].translations[0]).length() / dt)
+        .filter(|v| v.is_finite())
+        .fold(0.0, f32::max)
 }
 
 /// Rotates a ground vector by a yaw quaternion.

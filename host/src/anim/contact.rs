@@ -175,37 +175,48 @@ pub struct GroundFix {
     pub max_depth: f32,
 }
 
-/// The lowest foot point's height in each frame of `clip` (∞ without legs).
-fn lowest_feet(clip: &Clip, legs: &[Leg]) -> Vec<f32> {
+/// Per frame of `clip`, per leg: the height of the foot's lowest point (∞ without points).
+fn foot_heights(clip: &Clip, legs: &[Leg]) -> Vec<Vec<f32>> {
     clip.frames
         .iter()
         .map(|p| {
             let world = clip.skeleton.positions(p);
             legs.iter()
-                .flat_map(|l| l.foot.iter())
-                .filter_map(|&j| world.get(j).map(|w| w.y))
-                .fold(f32::INFINITY, f32::min)
+                .map(|l| {
+                    l.foot
+                        .iter()
+                        .filter_map(|&j| world.get(j).map(|w| w.y))
+                        .fold(f32::INFINITY, f32::min)
+                })
+                .collect()
         })
         .collect()
 }
 
 /// Keeps on the ground the feet that `src` had on it: `out` (the same frames after effort
 /// transfer, which rescales the root's height) is moved up or down, frame by frame, so that
-/// its lowest foot is as high as the source's was wherever the source stood (its lowest foot
-/// within [`CONTACT_HEIGHT`] of the ground); in the air the correction of the frames around is
+/// the foot the source stood on (its lowest, when within [`CONTACT_HEIGHT`] of the ground) is
+/// as high as it was in the source; in the air the correction of the frames around is
 /// blended, so an amplified jump flies higher but takes off and lands where the source did.
+/// The standing foot, not whichever foot is now lowest, sets the height: an amplified kick
+/// swings its free foot through the floor (the ground pass lifts that foot with IK), and
+/// lifting the whole body onto it would pop the character a metre up for a frame.
 /// Returns the largest correction, metres.
 pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
     let legs = find_legs(src);
     if legs.is_empty() || src.len() != out.len() {
         return 0.0;
     }
-    let was = lowest_feet(src, &legs);
-    let now = lowest_feet(out, &legs);
+    let was = foot_heights(src, &legs);
+    let now = foot_heights(out, &legs);
     let grounded: Vec<Option<f32>> = was
         .iter()
         .zip(&now)
-        .map(|(&w, &n)| (w < GROUND_Y + CONTACT_HEIGHT && (w - n).is_finite()).then_some(w - n))
+        .map(|(w, n)| {
+            let (leg, &low) = w.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+            let d = low - n.get(leg)?;
+            (low < GROUND_Y + CONTACT_HEIGHT && d.is_finite()).then_some(d)
+        })
         .collect();
     let mut largest = 0.0f32;
     for (f, pose) in out.frames.iter_mut().enumerate() {

@@ -31,8 +31,8 @@
 
 use glam::{Quat, Vec3};
 
-use super::contact::keep_source_contacts;
-use super::joint_limits::{find_hinges, limit_hinges};
+use super::contact::{find_legs, keep_source_contacts};
+use super::joint_limits::{find_hinges, limit_hinges, JointRanges};
 use super::phrasing::{Phrasing, Stage};
 use crate::motion::{Clip, Pose, Skeleton};
 
@@ -42,6 +42,9 @@ pub const ALPHA: f32 = 1.5;
 pub const RESHAPE_RAD: f32 = 0.1;
 /// Floor of the normalised joint speed in the arc-length reparametrisation.
 pub const SPEED_FLOOR: f32 = 0.1;
+/// Bisection steps finding how far a joint may be rescaled within its range (1/256 of the
+/// factor's span).
+const RANGE_BISECTIONS: usize = 8;
 /// Sub-samples per source frame when tabulating time maps.
 const SUBSTEPS: usize = 4;
 
@@ -110,6 +113,71 @@ impl EffortClip {
     }
 }
 
+impl EffortClip {
+    /// This clip played over `seconds` with its root never faster than `top_speed` (m/s):
+    /// where the time map would move the root faster (a sudden retime compressing a lunge or a
+    /// take-off, a long clip squeezed into a short event), that stretch is given the time the
+    /// speed needs and the rest of the clip gives it back, its own timing scaled evenly; only
+    /// when even that cannot make room does the clip take longer. Returns the clip and the
+    /// seconds it now lasts (≥ `seconds`). The effort's shape stays: slow parts stay slow,
+    /// fast parts as fast as a person moves.
+    pub fn paced(&self, seconds: f32, top_speed: f32) -> (EffortClip, f32) {
+        let n = self.table.len();
+        if n < 2 || !(seconds > 0.0 && top_speed > 0.0) {
+            return (self.clone(), seconds.max(0.0));
+        }
+        let root = |s: f32| self.clip.sample(s).translations[0];
+        let positions: Vec<Vec3> = self.table.iter().map(|e| root(e.1)).collect();
+        let need: Vec<f32> = positions
+            .windows(2)
+            .map(|w| (w[1] - w[0]).length() / top_speed)
+            .collect();
+        let have: Vec<f32> = self
+            .table
+            .windows(2)
+            .map(|w| (w[1].0 - w[0].0) * seconds)
+            .collect();
+        if need.iter().zip(&have).all(|(n, h)| n <= h) {
+            return (self.clone(), seconds);
+        }
+        let total =
+            |alpha: f32| -> f32 { need.iter().zip(&have).map(|(n, h)| n.max(alpha * h)).sum() };
+        // The largest α ≤ 1 whose stretched timing fits in `seconds` (bisection; total(α) is
+        // increasing), else the clip's timing at α = 0: every stretch as fast as allowed.
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        for _ in 0..PACE_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if total(mid) <= seconds {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let out_seconds = total(lo).max(seconds);
+        let mut table = Vec::with_capacity(n);
+        let mut t = 0.0;
+        table.push((0.0, self.table[0].1));
+        for (k, (nk, hk)) in need.iter().zip(&have).enumerate() {
+            t += nk.max(lo * hk);
+            table.push(((t / out_seconds).min(1.0), self.table[k + 1].1));
+        }
+        if let Some(last) = table.last_mut() {
+            last.0 = 1.0;
+        }
+        (
+            EffortClip {
+                clip: self.clip.clone(),
+                phrasing: self.phrasing.clone(),
+                table,
+            },
+            out_seconds,
+        )
+    }
+}
+
+/// Bisection steps of [`EffortClip::paced`].
+const PACE_BISECTIONS: usize = 24;
+
 /// Interpolates a monotone table; `inverse` looks up by the second column.
 fn lookup(table: &[(f32, f32)], x: f32, inverse: bool) -> f32 {
     let key = |e: &(f32, f32)| if inverse { e.1 } else { e.0 };
@@ -134,13 +202,23 @@ fn lookup(table: &[(f32, f32)], x: f32, inverse: bool) -> f32 {
 
 /// Applies Time and Weight efforts to a clip with the given phrasing; `forward` is the rig's
 /// facing in its own frame (the clip library's `forward`), which defines the spine's bending axis;
-/// `scale_travel` rescales the root's ground travel with the stride (cyclic clips).
+/// `ranges` (the library's joint ranges, if known) bound every joint after rescaling.
+///
+/// `cyclic` clips (gait cycles) are treated as locomotion: their root's ground travel follows
+/// the rescaled stride — scaled by how much wider or narrower the feet now sweep relative to
+/// the hips ([`stride_ratio`]), so a cycle covers the distance its legs step — and their clock
+/// is left uniform within the cycle. A gait's timing within a step is set by the body's
+/// mechanics (a foot lands when it lands); eq. 6's warp inside every cycle would make the
+/// body lurch from 1 to 8 m/s each step. Their Time shows in the cadence instead: the
+/// assembler fits whole cycles into the doodle's own duration, short for sudden doodles and
+/// long for sustained ones.
 pub fn apply_effort(
     clip: &Clip,
     phrasing: &Phrasing,
     effort: Effort,
     forward: Vec3,
-    scale_travel: bool,
+    cyclic: bool,
+    ranges: Option<&JointRanges>,
 ) -> EffortClip {
     let e = effort.sanitized();
     let mut out = clip.clone();
@@ -164,9 +242,14 @@ pub fn apply_effort(
             (s.start, s.end, time_part * c_w)
         })
         .collect();
-    rescale_stages(clip, &mut out, &factors, scale_travel);
-    // An amplified swing stays a human one: no knee or elbow bent backwards.
+    // An amplified swing stays a human one: every joint within the range the library's actors
+    // moved it in, and no knee or elbow bent backwards.
+    rescale_stages(clip, &mut out, &factors, ranges);
     limit_hinges(&find_hinges(clip), &mut out);
+    if cyclic {
+        let ratio = stride_ratio(clip, &out);
+        scale_travel(clip, &mut out, ratio);
+    }
     // A rescaled height flies higher where the source flew, but stands where it stood.
     keep_source_contacts(clip, &mut out);
     reshape(&mut out, e.weight, forward);
@@ -176,11 +259,15 @@ pub fn apply_effort(
     let mean = speeds.iter().sum::<f32>() / speeds.len().max(1) as f32;
     // Output time spent per source second ∝ V^k: k < 0 makes fast parts faster and slow parts
     // slower (strong); 0 < k ≤ 1 evens the speed out (light), k = 1 being uniform speed.
-    let k = if e.weight >= 0.0 {
+    let k = if cyclic {
+        0.0
+    } else if e.weight >= 0.0 {
         -ALPHA * e.weight
     } else {
         (ALPHA * -e.weight).min(1.0)
     };
+    // Cycles keep their own clock (see above): no stage warp either.
+    let lt = if cyclic { 0.0 } else { e.time };
     let mut arc = vec![0.0f32; n];
     for i in 1..n {
         let v = if mean > 1e-9 {
@@ -208,7 +295,7 @@ pub fn apply_effort(
         let mut acc = 0.0;
         for &(stage, a, b) in &bounds {
             let local = (g.min(b) - a).max(0.0);
-            let (ak, bk) = stage_params(stage, e.time);
+            let (ak, bk) = stage_params(stage, lt);
             acc += ak * local.powf(bk);
             if g <= b {
                 break;
@@ -304,7 +391,17 @@ fn quat_pow(q: Quat, c: f32) -> Quat {
 }
 
 /// Eq. 7 per stage, references chained so the result is continuous.
-fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], travel: bool) {
+/// Each joint's rotation is rescaled by `c` unless that leaves its range (`ranges`); then by
+/// the factor between 1 and `c` nearest `c` that keeps it within (bisection on the factor, so
+/// the joint stops where the amplified swing meets the edge of its range rather than being
+/// clamped after the fact, which for a swing amplified past half a turn would flip it to the
+/// opposite side).
+fn rescale_stages(
+    src: &Clip,
+    out: &mut Clip,
+    factors: &[(usize, usize, f32)],
+    ranges: Option<&JointRanges>,
+) {
     let joints = src.skeleton.len();
     let Some(first) = src.frames.first() else {
         return;
@@ -322,24 +419,33 @@ fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], t
                 if j == 0 {
                     // The root's orientation is the body's facing and balance: rescaling it
                     // would over- or under-turn the character and tip it over. Its height is
-                    // rescaled like any translation; its ground travel only for cycles, where
-                    // the distance per cycle follows the rescaled stride (a light walk takes
-                    // shorter steps and, along a given path, more cycles).
+                    // rescaled like any translation; its ground travel is the legs' doing
+                    // (see `scale_travel`).
                     let ts = ref_src.translations[0];
                     let tt = p.translations[0];
-                    let scaled = ref_out.translations[0] + (tt - ts) * c;
-                    if travel {
-                        o.translations[0] = scaled;
-                    } else {
-                        o.translations[0].y = scaled.y;
-                    }
+                    o.translations[0].y = ref_out.translations[0].y + (tt.y - ts.y) * c;
                     continue;
                 }
                 let qs = ref_src.rotations[j];
                 let qt = p.rotations[j];
                 // eq. 7: q(t) = scale(q(s) q(t)^-1, c)^-1 q(s), with q(s) → rescaled reference.
-                let d = quat_pow(qs * qt.inverse(), c);
-                o.rotations[j] = (d.inverse() * ref_out.rotations[j]).normalize();
+                let at = |c: f32| {
+                    (quat_pow(qs * qt.inverse(), c).inverse() * ref_out.rotations[j]).normalize()
+                };
+                let mut q = at(c);
+                if let Some(r) = ranges.filter(|r| !r.contains(j, q) && r.contains(j, at(1.0))) {
+                    let (mut inside, mut outside) = (1.0, c);
+                    for _ in 0..RANGE_BISECTIONS {
+                        let mid = 0.5 * (inside + outside);
+                        if r.contains(j, at(mid)) {
+                            inside = mid;
+                        } else {
+                            outside = mid;
+                        }
+                    }
+                    q = at(inside);
+                }
+                o.rotations[j] = q;
                 let ts = ref_src.translations[j];
                 let tt = p.translations[j];
                 let scaled = ref_out.translations[j] + (tt - ts) * c;
@@ -351,6 +457,57 @@ fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], t
         if let Some(end) = out.frames.get(e.min(src.len().saturating_sub(1))) {
             ref_out = end.clone();
         }
+    }
+}
+
+/// How much wider (> 1) or narrower the feet of `out` sweep than those of `src` (the same
+/// frames before rescaling): per leg, the extent of the ankle's position relative to the
+/// hips along the clip's direction of travel, summed over the legs. 1 when the source's feet
+/// do not sweep (or it has no legs, or does not travel).
+pub fn stride_ratio(src: &Clip, out: &Clip) -> f32 {
+    let legs = find_legs(src);
+    let root = src.root_path();
+    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
+        return 1.0;
+    };
+    let Some(dir) = Vec3::new(rl.x - r0.x, 0.0, rl.z - r0.z).try_normalize() else {
+        return 1.0;
+    };
+    let sweep = |c: &Clip| -> f32 {
+        let pos = c.all_positions();
+        legs.iter()
+            .map(|l| {
+                let along = pos.iter().filter_map(|p| {
+                    Some((*p.get(l.ankle)? - *p.first()?).dot(dir)).filter(|v| v.is_finite())
+                });
+                let (lo, hi) = along.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                });
+                if hi >= lo {
+                    hi - lo
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    };
+    let before = sweep(src);
+    if before < 1e-3 {
+        return 1.0;
+    }
+    sweep(out) / before
+}
+
+/// Scales the root's ground travel (from the first frame) of `out` by `ratio`, from that of
+/// `src` (the same frames before rescaling).
+fn scale_travel(src: &Clip, out: &mut Clip, ratio: f32) {
+    let Some(r0) = src.frames.first().map(|p| p.translations[0]) else {
+        return;
+    };
+    for (p, o) in src.frames.iter().zip(&mut out.frames) {
+        let t = p.translations[0];
+        o.translations[0].x = r0.x + (t.x - r0.x) * ratio;
+        o.translations[0].z = r0.z + (t.z - r0.z) * ratio;
     }
 }
 
@@ -480,7 +637,7 @@ mod tests {
             return;
         };
         let ph = detect_stages(&c);
-        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X, false);
+        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X, false, None);
         for (a, b) in e.clip.frames.iter().zip(&c.frames) {
             for (qa, qb) in a.rotations.iter().zip(&b.rotations) {
                 assert!(qa.dot(*qb).abs() > 1.0 - 1e-6);
@@ -511,6 +668,7 @@ mod tests {
                 },
                 Vec3::X,
                 false,
+                None,
             );
             let (a, b) = e.stage_w(Stage::Execution).unwrap();
             b - a
@@ -538,6 +696,7 @@ mod tests {
             },
             Vec3::X,
             false,
+            None,
         );
         let strong = apply_effort(
             &c,
@@ -548,6 +707,7 @@ mod tests {
             },
             Vec3::X,
             false,
+            None,
         );
         let mid = c.len() / 2;
         assert!(spine_tilt(&strong.clip, mid) > spine_tilt(&light.clip, mid));
