@@ -287,9 +287,18 @@ pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
     fix
 }
 
+/// Least forward bend (rad) of a knee before IK bends it further: the solver keeps the side
+/// a knee is bent to, so a straight or overextended knee is first turned this far forward.
+pub const KNEE_FORWARD_RAD: f32 = 0.05;
+
 /// Two-bone IK: rotates hip and knee so the ankle reaches `target` (or as close as the leg
-/// allows), keeping the knee's bending plane and the foot's world orientation.
+/// allows), keeping the knee's bending plane and the foot's world orientation. A knee bends
+/// forward, towards the toes: the solver bends a knee further on the side it is already bent
+/// to, so a knee that is straight or overextended (the shin swung forward of the thigh, as
+/// rescaling or a blend may leave it) is first turned to [`KNEE_FORWARD_RAD`] forward —
+/// else IK would fold it backwards.
 pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, target: Vec3) {
+    bend_knee_forward(sk, pose, leg);
     let world = sk.forward(pose);
     let (a, b, c) = (
         world[leg.hip].position,
@@ -341,6 +350,61 @@ pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, tar
     // Keep the foot's world orientation.
     let knee_world = sk.forward(pose)[leg.knee].rotation;
     pose.rotations[leg.ankle] = (knee_world.inverse() * c_gr).normalize();
+}
+
+/// Turns a straight or overextended knee of `leg` to [`KNEE_FORWARD_RAD`] forward (see
+/// [`two_bone_ik`]): in the plane of the thigh and the knee's forward direction, the shin is
+/// swung back until it trails the thigh by that angle. The knee's forward direction is the
+/// toes' in the rest pose (a straight leg, feet forward), carried by the thigh: a hinge's
+/// forward turns with the thigh, not with the foot (pointed toes would say nothing). Legs
+/// without a point beyond the ankle are left alone.
+fn bend_knee_forward(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg) {
+    let rest = sk.positions(&crate::motion::Pose::rest(sk));
+    let Some(toe) = leg
+        .foot
+        .iter()
+        .filter(|&&j| j != leg.ankle)
+        .filter_map(|&j| Some(*rest.get(j)? - *rest.get(leg.ankle)?))
+        .max_by(|x, y| x.length_squared().total_cmp(&y.length_squared()))
+    else {
+        return;
+    };
+    let (Some(&hip0), Some(&knee0)) = (rest.get(leg.hip), rest.get(leg.knee)) else {
+        return;
+    };
+    let Some(u0) = (knee0 - hip0).try_normalize() else {
+        return;
+    };
+    let Some(f0) = (toe - u0 * toe.dot(u0)).try_normalize() else {
+        return;
+    };
+    let world = sk.forward(pose);
+    let (a, b, c) = (
+        world[leg.hip].position,
+        world[leg.knee].position,
+        world[leg.ankle].position,
+    );
+    let Some(u) = (b - a).try_normalize() else {
+        return;
+    };
+    let Some(d) = (c - b).try_normalize() else {
+        return;
+    };
+    let f = world[leg.hip].rotation * f0;
+    let Some(f) = (f - u * f.dot(u)).try_normalize() else {
+        return;
+    };
+    // Signed angle of the shin from the thigh towards the toes: > 0 is overextended.
+    let beta = d.dot(f).atan2(d.dot(u));
+    if beta <= -KNEE_FORWARD_RAD {
+        return;
+    }
+    let Some(axis) = u.cross(-f).try_normalize() else {
+        return;
+    };
+    let b_gr = world[leg.knee].rotation;
+    let turn = Quat::from_axis_angle((b_gr.inverse() * axis).normalize(), beta + KNEE_FORWARD_RAD);
+    pose.rotations[leg.knee] = (pose.rotations[leg.knee] * turn).normalize();
 }
 
 #[cfg(test)]
