@@ -754,8 +754,8 @@ fn place_action(
 ///   within that range of cadence; a path too short for it gets more, shorter steps (a slow
 ///   run steps short, the stretched-down root and the foot pinning keep the feet planted); a
 ///   path too long for it — the doodle's pace times the world scale beyond what the action's
-///   longest stride at its quickest cadence covers — is shrunk, about its start, to what that
-///   pace covers in the time (its shape kept). The doodle's world scale thus says how big the
+///   stride at its quickest cadence covers, or beyond [`HUMAN_ROOT_SPEED_M_S`] on average —
+///   is shrunk, about its start, to what that pace covers in the time (its shape kept). The doodle's world scale thus says how big the
 ///   path is wherever a person can cover it, and the animation keeps the doodle's timing; a
 ///   character does not sprint 7 m/s because a toy was swept fast across a table.
 /// - **Not cyclic** (jump): the path is shrunk to at most the (effort-rescaled) clip's own
@@ -774,10 +774,11 @@ fn pace(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> (P
         // Cycles at the quickest and slowest cadence that fill the duration.
         let most = ((duration * MAX_CADENCE / cycle_s).floor() as usize).max(1);
         let least = ((duration / (MAX_CADENCE * cycle_s)).ceil() as usize).clamp(1, most);
-        let by_path = (len / travel).round() as usize;
-        let cycles = by_path.clamp(least, most);
-        let reach = cycles as f32 * travel;
-        (shrink(chunk, reach), cycles)
+        // Nor faster on average than the fastest person (HUMAN_ROOT_SPEED_M_S).
+        let reach = (most as f32 * travel).min(HUMAN_ROOT_SPEED_M_S * duration);
+        let chunk = shrink(chunk, reach);
+        let cycles = ((chunk.length() / travel).round() as usize).clamp(least, most);
+        (chunk, cycles)
     } else if ac.moving && !ac.cyclic && len > 0.05 {
         (shrink(chunk, travel.max(0.05)), 1)
     } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {

@@ -115,10 +115,10 @@ pub fn detect_contacts(clip: &Clip, legs: &[Leg]) -> Vec<Vec<bool>> {
 /// Frames over which a pinned foot eases in and out of its pin.
 pub const PIN_EASE_FRAMES: usize = 3;
 
-/// Pins planted feet: for every run of contact frames of a leg, the ankle is held (in the
-/// ground plane) where it was in the run's middle frame, by two-bone IK, easing in and out
-/// over [`PIN_EASE_FRAMES`] frames; its height stays the animation's. Unreachable pins are
-/// approached as far as the leg allows.
+/// Pins planted feet: for every run of contact frames of a leg, the foot's contact point (its
+/// lowest in the run's middle frame) is held (in the ground plane) where it was in that
+/// frame, by two-bone IK, easing in and out over [`PIN_EASE_FRAMES`] frames; its height stays
+/// the animation's. Unreachable pins are approached as far as the leg allows.
 pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
     let sk = clip.skeleton.clone();
     let n = clip.len();
@@ -138,7 +138,18 @@ pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
                 continue;
             }
             let mid = (a + b) / 2;
-            let pin = sk.positions(&clip.frames[mid])[leg.ankle];
+            // The point the foot stands on (its lowest in the run's middle frame) is held,
+            // not the ankle: a foot that pivots about its toes on a pinned ankle still slides
+            // its toes across the floor. IK keeps the foot's orientation, so moving the ankle
+            // by the contact point's slip puts the contact point back.
+            let mid_pos = sk.positions(&clip.frames[mid]);
+            let point = leg
+                .foot
+                .iter()
+                .copied()
+                .min_by(|&i, &j| mid_pos[i].y.total_cmp(&mid_pos[j].y))
+                .unwrap_or(leg.ankle);
+            let pin = mid_pos[point];
             let lo = a.saturating_sub(PIN_EASE_FRAMES);
             let hi = (b + PIN_EASE_FRAMES).min(n - 1);
             for g in lo..=hi {
@@ -150,11 +161,12 @@ pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
                     1.0
                 };
                 let pose = &mut clip.frames[g];
-                let own = sk.positions(pose)[leg.ankle];
+                let world = sk.positions(pose);
+                let (own, at) = (world[leg.ankle], world[point]);
                 let target = Vec3::new(
-                    own.x + (pin.x - own.x) * w,
+                    own.x + (pin.x - at.x) * w,
                     own.y,
-                    own.z + (pin.z - own.z) * w,
+                    own.z + (pin.z - at.z) * w,
                 );
                 if (target - own).length() > 1e-5 {
                     two_bone_ik(&sk, pose, leg, target);
