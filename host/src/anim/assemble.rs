@@ -62,6 +62,11 @@ pub const MAX_CADENCE: f32 = 1.5;
 /// would is given more time.
 pub const HUMAN_ROOT_SPEED_M_S: f32 = super::check::envelope::ROOT_SPEED_M_S;
 
+/// Share of [`HUMAN_ROOT_SPEED_M_S`] an action is paced to: the passes after placement (the
+/// ground pass raising a root whose leg cannot reach, blends between actions) move the root
+/// by a few millimetres more per frame, so pacing to the limit itself would end just over it.
+pub const PACE_HEADROOM: f32 = 0.97;
+
 /// Most frames an assembled animation may have (two hours at 30 fps; ≈ 360 MB of poses for a
 /// 60-joint rig): events whose times span more are refused rather than exhausting memory.
 pub const MAX_OUTPUT_FRAMES: usize = 216_000;
@@ -334,10 +339,22 @@ pub fn assemble_guided(
         let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
         let mut f1 = frame_of(ev.end).max(f0 + min_len.max(2));
         // Nor does any stretch of it move the root faster than a person: the time map gives
-        // such stretches the time they need (see `EffortClip::paced`), per cycle.
+        // such stretches the time they need (see `EffortClip::paced`), per cycle. A gait whose
+        // path is longer than its cycles' travel moves its root that much faster.
+        let stretch = if ac.moving && ac.cyclic {
+            let travel = ec.clip.root_path();
+            let per_cycle = match (travel.first(), travel.last()) {
+                (Some(&a), Some(&b)) => ground(b - a).length(),
+                _ => 0.0,
+            };
+            (chunk.length() / (cycles.max(1) as f32 * per_cycle).max(1e-3)).max(1.0)
+        } else {
+            1.0
+        };
+        let top_speed = HUMAN_ROOT_SPEED_M_S * PACE_HEADROOM;
         let (ec, cycle_s) = ec.paced(
             (f1 - f0) as f32 / fps / cycles.max(1) as f32,
-            HUMAN_ROOT_SPEED_M_S,
+            top_speed / stretch,
         );
         f1 = f1.max(f0 + (cycle_s * cycles.max(1) as f32 * fps).ceil() as usize);
         // Nor faster than a person moves: an action whose root would outrun
@@ -359,11 +376,11 @@ pub fn assemble_guided(
             cursor = start.clone();
             placed_action = place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
             let fastest = root_speed_max(&placed_action.0, 1.0 / fps);
-            if fastest <= HUMAN_ROOT_SPEED_M_S || f1 >= slowest {
+            if fastest <= top_speed || f1 >= slowest {
                 break;
             }
             let n = (f1 - f0) as f32;
-            let need = (n * fastest / HUMAN_ROOT_SPEED_M_S).ceil().max(n + 1.0) as usize;
+            let need = (n * fastest / top_speed).ceil().max(n + 1.0) as usize;
             f1 = (f0 + need).min(slowest);
         }
         let duration = (f1 - f0) as f32 / fps;
