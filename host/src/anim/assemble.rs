@@ -8,7 +8,9 @@
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
 //! - **moving, cyclic** (walk, run): whole cycles, as many as fit the path (`round(L / C)`,
-//!   C = the clip's travel per cycle); the root advances along the path by the clip's own
+//!   C = the clip's travel per cycle), within a human range of cadence ([`MAX_CADENCE`]);
+//!   a path longer than that cadence (or [`HUMAN_ROOT_SPEED_M_S`]) covers in the time is
+//!   shrunk about its start (see `pace`); the root advances along the path by the clip's own
 //!   progress (stretched by `L / (m C)`), so feet do not skate; heading = path tangent;
 //! - **moving, not cyclic** (jump): the root stays in place while the clip's own root does
 //!   not travel (anticipation, landing, follow-through) and moves along the path, in step
@@ -23,7 +25,9 @@
 //!   cyclic walks along the path too).
 //!
 //! Actions start at their event's start; an event shorter than its clip allows at
-//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
+//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×),
+//! and so does one whose root would move faster than [`HUMAN_ROOT_SPEED_M_S`] even when the
+//! fast stretches borrow time from the slow ones ([`super::effort::EffortClip::paced`]).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
 //! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted

@@ -21,13 +21,19 @@
 //!   sinking forward, light rising.
 //!
 //! Eq. 7 is applied with each stage's reference chained to the previous stage's rescaled end,
-//! so the rescaled motion stays continuous at stage boundaries; the hinges (knees, elbows) are
-//! then held within the range they bend in ([`super::joint_limits`]), and the frames in which
-//! the source stood are put back on the ground ([`super::contact::keep_source_contacts`]): a
-//! strong jump flies higher, a strong punch does not hover. The root's orientation (the
-//! body's facing and balance) is left alone; its height is rescaled, and its ground travel
-//! too for cyclic clips so that the distance per cycle follows the rescaled stride. Feet that
-//! slide because of rescaling are pinned afterwards by the assembler's contact pass.
+//! so the rescaled motion stays continuous at stage boundaries. Every joint is rescaled only
+//! as far as it stays within the range the library's actors moved it in
+//! ([`super::joint_limits::JointRanges`]; a strong run's hips swing wider, but never into a
+//! split), the hinges (knees, elbows) are then held within the range they bend in
+//! ([`super::joint_limits`]), and the frames in which the source stood are put back on the
+//! ground ([`super::contact::keep_source_contacts`]): a strong jump flies higher, a strong
+//! punch does not hover. The root's orientation (the body's facing and balance) is left
+//! alone; its height is rescaled, and for cyclic clips its ground travel follows the feet's
+//! rescaled sweep ([`stride_ratio`]) so that a cycle covers the distance its legs step.
+//! Cyclic clips (gaits) keep their clock within the cycle; their Time shows in the cadence
+//! (see [`apply_effort`]). Feet that slide because of rescaling are pinned afterwards by the
+//! assembler's contact pass, and [`EffortClip::paced`] keeps a retimed clip's root within
+//! the speed a person moves at.
 
 use glam::{Quat, Vec3};
 
