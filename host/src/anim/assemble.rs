@@ -8,7 +8,7 @@
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
 //! - **moving, cyclic** (walk, run): whole cycles, as many as fit the path (`round(L / C)`,
-//!   C = the clip's travel per cycle), within a human range of cadence ([`MAX_CADENCE`]);
+//!   C = the clip's travel per cycle), within a human range of cadence ([`super::pacing::MAX_CADENCE`]);
 //!   a path longer than that cadence (or [`HUMAN_ROOT_SPEED_M_S`]) covers in the time is
 //!   shrunk about its start (see `pace`); the root advances along the path by the clip's own
 //!   progress (stretched by `L / (m C)`), so feet do not skate; heading = path tangent;
@@ -43,6 +43,7 @@ use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
+use super::pacing::{pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
@@ -54,22 +55,6 @@ use crate::poselog::PoseLog;
 
 /// Fastest playback of a clip relative to its own speed (before effort retiming).
 pub const MAX_SPEEDUP: f32 = 3.0;
-
-/// How many times more (or fewer) steps a gait may take per second than its clip does. People
-/// walk at about 70–140 steps a minute and run at 150–230 (a sprint), about 1.5× either side
-/// of an everyday pace; beyond it a walk would turn into a run, a run into a shuffle.
-pub const MAX_CADENCE: f32 = 1.5;
-
-/// The fastest a character's root may move, m/s: the fastest real take the project fetches
-/// (DeepMimic's run, 4.2 m/s), the same limit `figurine check` judges against
-/// ([`super::check::envelope::ROOT_SPEED_M_S`]). No person's hips outrun it; an action that
-/// would is given more time.
-pub const HUMAN_ROOT_SPEED_M_S: f32 = super::check::envelope::ROOT_SPEED_M_S;
-
-/// Share of [`HUMAN_ROOT_SPEED_M_S`] an action is paced to: the passes after placement (the
-/// ground pass raising a root whose leg cannot reach, blends between actions) move the root
-/// by a few millimetres more per frame, so pacing to the limit itself would end just over it.
-pub const PACE_HEADROOM: f32 = 0.97;
 
 /// Most frames an assembled animation may have (two hours at 30 fps; ≈ 360 MB of poses for a
 /// 60-joint rig): events whose times span more are refused rather than exhausting memory.
@@ -764,69 +749,6 @@ fn place_action(
         }
     }
     (poses, world_path, cycles, src_times)
-}
-
-/// The path a moving action covers in `duration` seconds and the cycles it plays on it, at a
-/// pace a person keeps.
-///
-/// - **Cyclic** (walk, run): a stride stays tied to the distance it covers, and steps come
-///   no more than [`MAX_CADENCE`] times as often as in the clip, nor less than 1/[`MAX_CADENCE`]
-///   as often. Whole cycles of the (effort-rescaled) clip's travel are fitted to the path
-///   within that range of cadence; a path too short for it gets more, shorter steps (a slow
-///   run steps short, the stretched-down root and the foot pinning keep the feet planted); a
-///   path too long for it — the doodle's pace times the world scale beyond what the action's
-///   stride at its quickest cadence covers, or beyond [`HUMAN_ROOT_SPEED_M_S`] on average —
-///   is shrunk, about its start, to what that pace covers in the time (its shape kept). The doodle's world scale thus says how big the
-///   path is wherever a person can cover it, and the animation keeps the doodle's timing; a
-///   character does not sprint 7 m/s because a toy was swept fast across a table.
-/// - **Not cyclic** (jump): the path is shrunk to at most the (effort-rescaled) clip's own
-///   travel: a jump lands where its take-off carries it.
-/// - **In place**: a looping clip repeats as many whole times as fill the duration at its
-///   own speed (so does a cyclic clip without a path); else 1.
-fn pace(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> (Polyline, usize) {
-    let root = ec.clip.root_path();
-    let travel = match (root.first(), root.last()) {
-        (Some(&r0), Some(&rl)) => ground(rl - r0).length(),
-        _ => 0.0,
-    };
-    let cycle_s = ec.clip.duration().max(1e-3);
-    let len = chunk.length();
-    if ac.moving && ac.cyclic && len > 0.05 && travel > 0.05 && duration.is_finite() {
-        // Cycles at the quickest and slowest cadence that fill the duration.
-        let most = ((duration * MAX_CADENCE / cycle_s).floor() as usize).max(1);
-        let least = ((duration / (MAX_CADENCE * cycle_s)).ceil() as usize).clamp(1, most);
-        // Nor faster on average than the fastest person (HUMAN_ROOT_SPEED_M_S).
-        let reach = (most as f32 * travel).min(HUMAN_ROOT_SPEED_M_S * duration);
-        let chunk = shrink(chunk, reach);
-        let cycles = ((chunk.length() / travel).round() as usize).clamp(least, most);
-        (chunk, cycles)
-    } else if ac.moving && !ac.cyclic && len > 0.05 {
-        (shrink(chunk, travel.max(0.05)), 1)
-    } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {
-        let cycles = (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize;
-        (chunk.clone(), cycles)
-    } else {
-        (chunk.clone(), 1)
-    }
-}
-
-/// `chunk` (starting at the origin) scaled about its start to at most `most` metres long.
-fn shrink(chunk: &Polyline, most: f32) -> Polyline {
-    let len = chunk.length();
-    if len <= most || len <= 0.0 {
-        return chunk.clone();
-    }
-    let f = most / len;
-    Polyline::new(chunk.pts.iter().map(|p| *p * f).collect())
-}
-
-/// The fastest the root of `poses` moves from one frame to the next, m/s.
-fn root_speed_max(poses: &[Pose], dt: f32) -> f32 {
-    poses
-        .windows(2)
-        .map(|w| (w[1].translations[0] - w[0].translations[0]).length() / dt)
-        .filter(|v| v.is_finite())
-        .fold(0.0, f32::max)
 }
 
 /// Rotates a ground vector by a yaw quaternion.

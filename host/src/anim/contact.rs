@@ -465,6 +465,24 @@ mod tests {
     }
 
     #[test]
+    fn ik_bends_an_overextended_knee_forward_not_further_back() {
+        // The toes point +Z; the shin swung 0.3 rad forward of the thigh (overextended).
+        let c = leg_clip();
+        let legs = find_legs(&c);
+        let mut pose = c.frames[0].clone();
+        pose.rotations[2] = Quat::from_rotation_x(-0.3);
+        let before = c.skeleton.positions(&pose);
+        let target = before[3] + Vec3::Y * 0.15;
+        two_bone_ik(&c.skeleton, &mut pose, &legs[0], target);
+        let p = c.skeleton.positions(&pose);
+        assert!((p[3] - target).length() < 1e-3, "{:?} {target}", p[3]);
+        // The knee stands forward (+Z) of the hip–ankle line.
+        let n = (p[3] - p[1]).normalize();
+        let off = (p[2] - p[1]) - n * (p[2] - p[1]).dot(n);
+        assert!(off.z > 0.02, "knee offset {off}");
+    }
+
+    #[test]
     fn unreachable_targets_raise_the_root() {
         let mut c = leg_clip();
         for p in &mut c.frames {

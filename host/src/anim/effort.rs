@@ -89,7 +89,7 @@ pub struct EffortClip {
     /// The stages of the source clip.
     pub phrasing: Phrasing,
     /// Monotone table of (w, source seconds), w from 0 to 1.
-    table: Vec<(f32, f32)>,
+    pub(super) table: Vec<(f32, f32)>,
 }
 
 impl EffortClip {
@@ -118,71 +118,6 @@ impl EffortClip {
         ))
     }
 }
-
-impl EffortClip {
-    /// This clip played over `seconds` with its root never faster than `top_speed` (m/s):
-    /// where the time map would move the root faster (a sudden retime compressing a lunge or a
-    /// take-off, a long clip squeezed into a short event), that stretch is given the time the
-    /// speed needs and the rest of the clip gives it back, its own timing scaled evenly; only
-    /// when even that cannot make room does the clip take longer. Returns the clip and the
-    /// seconds it now lasts (≥ `seconds`). The effort's shape stays: slow parts stay slow,
-    /// fast parts as fast as a person moves.
-    pub fn paced(&self, seconds: f32, top_speed: f32) -> (EffortClip, f32) {
-        let n = self.table.len();
-        if n < 2 || !(seconds > 0.0 && top_speed > 0.0) {
-            return (self.clone(), seconds.max(0.0));
-        }
-        let root = |s: f32| self.clip.sample(s).translations[0];
-        let positions: Vec<Vec3> = self.table.iter().map(|e| root(e.1)).collect();
-        let need: Vec<f32> = positions
-            .windows(2)
-            .map(|w| (w[1] - w[0]).length() / top_speed)
-            .collect();
-        let have: Vec<f32> = self
-            .table
-            .windows(2)
-            .map(|w| (w[1].0 - w[0].0) * seconds)
-            .collect();
-        if need.iter().zip(&have).all(|(n, h)| n <= h) {
-            return (self.clone(), seconds);
-        }
-        let total =
-            |alpha: f32| -> f32 { need.iter().zip(&have).map(|(n, h)| n.max(alpha * h)).sum() };
-        // The largest α ≤ 1 whose stretched timing fits in `seconds` (bisection; total(α) is
-        // increasing), else the clip's timing at α = 0: every stretch as fast as allowed.
-        let (mut lo, mut hi) = (0.0f32, 1.0f32);
-        for _ in 0..PACE_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if total(mid) <= seconds {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let out_seconds = total(lo).max(seconds);
-        let mut table = Vec::with_capacity(n);
-        let mut t = 0.0;
-        table.push((0.0, self.table[0].1));
-        for (k, (nk, hk)) in need.iter().zip(&have).enumerate() {
-            t += nk.max(lo * hk);
-            table.push(((t / out_seconds).min(1.0), self.table[k + 1].1));
-        }
-        if let Some(last) = table.last_mut() {
-            last.0 = 1.0;
-        }
-        (
-            EffortClip {
-                clip: self.clip.clone(),
-                phrasing: self.phrasing.clone(),
-                table,
-            },
-            out_seconds,
-        )
-    }
-}
-
-/// Bisection steps of [`EffortClip::paced`].
-const PACE_BISECTIONS: usize = 24;
 
 /// Interpolates a monotone table; `inverse` looks up by the second column.
 fn lookup(table: &[(f32, f32)], x: f32, inverse: bool) -> f32 {
