@@ -256,6 +256,92 @@ pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
     largest
 }
 
+/// Frames either side over which [`keep_feet_above_floor`] spreads a frame's restraint, so
+/// that the rescaling eases off and back on rather than snapping.
+pub const FLOOR_EASE_FRAMES: usize = 4;
+/// Bisection steps of [`keep_feet_above_floor`].
+const FLOOR_BISECTIONS: usize = 10;
+
+/// Where rescaling sends a foot through the floor deeper than [`CONTACT_HEIGHT`] (an
+/// amplified free leg swung down while the standing leg, folded deeper, lowered the body),
+/// draws the legs of `out` back towards `src` (the same frames before effort transfer) just
+/// enough that it does not: per frame the largest share of the change (the legs' rotations
+/// slerped, the root's height interpolated) that keeps every foot above `−CONTACT_HEIGHT`, the smallest share over
+/// [`FLOOR_EASE_FRAMES`] either side applied. The ground pass's IK lifts what a foot may
+/// still sink; deeper, it would fold the knee shut. The floor bounds an amplified swing as
+/// the joints' ranges do. Returns how many frames it drew back.
+pub fn keep_feet_above_floor(src: &Clip, out: &mut Clip) -> usize {
+    let legs = find_legs(src);
+    if legs.is_empty() || src.len() != out.len() {
+        return 0;
+    }
+    // Only the legs are drawn back (and the root's height): the arms keep their effort.
+    let leg_joints: Vec<usize> = legs
+        .iter()
+        .flat_map(|l| [l.hip, l.knee].into_iter().chain(l.foot.iter().copied()))
+        .collect();
+    let blend = |a: &crate::motion::Pose, b: &crate::motion::Pose, s: f32| {
+        let mut p = b.clone();
+        for &j in &leg_joints {
+            if let (Some(q), Some(qa), Some(qb)) = (
+                p.rotations.get_mut(j),
+                a.rotations.get(j),
+                b.rotations.get(j),
+            ) {
+                *q = qa.slerp(*qb, s).normalize();
+            }
+        }
+        if let (Some(t), Some(ta), Some(tb)) = (
+            p.translations.first_mut(),
+            a.translations.first(),
+            b.translations.first(),
+        ) {
+            t.y = ta.y + (tb.y - ta.y) * s;
+        }
+        p
+    };
+    let lowest = |p: &crate::motion::Pose| {
+        let w = out.skeleton.positions(p);
+        legs.iter()
+            .flat_map(|l| l.foot.iter())
+            .filter_map(|&j| w.get(j).map(|v| v.y))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let floor = GROUND_Y - CONTACT_HEIGHT;
+    let share: Vec<f32> = src
+        .frames
+        .iter()
+        .zip(&out.frames)
+        .map(|(a, b)| {
+            if lowest(b) >= floor || lowest(a) < floor {
+                return 1.0;
+            }
+            let (mut ok, mut bad) = (0.0f32, 1.0f32);
+            for _ in 0..FLOOR_BISECTIONS {
+                let mid = 0.5 * (ok + bad);
+                if lowest(&blend(a, b, mid)) >= floor {
+                    ok = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            ok
+        })
+        .collect();
+    let n = share.len();
+    let mut changed = 0;
+    for f in 0..n {
+        let lo = f.saturating_sub(FLOOR_EASE_FRAMES);
+        let hi = (f + FLOOR_EASE_FRAMES).min(n - 1);
+        let s = share[lo..=hi].iter().copied().fold(1.0f32, f32::min);
+        if s < 1.0 {
+            out.frames[f] = blend(&src.frames[f], &out.frames[f], s);
+            changed += 1;
+        }
+    }
+    changed
+}
+
 /// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
 /// cannot reach, the root is raised by what remains.
 pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
@@ -480,6 +566,34 @@ mod tests {
         let n = (p[3] - p[1]).normalize();
         let off = (p[2] - p[1]) - n * (p[2] - p[1]).dot(n);
         assert!(off.z > 0.02, "knee offset {off}");
+    }
+
+    #[test]
+    fn a_foot_rescaled_through_the_floor_is_drawn_back_and_the_rest_kept() {
+        // The source stands on the ground for 12 frames; the rescaled copy sinks 0.3 m in
+        // frames 5–6 and nowhere else.
+        let base = leg_clip();
+        let mut src = base.clone();
+        src.frames = vec![base.frames[0].clone(); 12];
+        let sink = src.joint_positions(0)[4].y.min(src.joint_positions(0)[3].y);
+        for p in &mut src.frames {
+            p.translations[0].y -= sink;
+        }
+        let mut out = src.clone();
+        for f in [5, 6] {
+            out.frames[f].translations[0].y -= 0.3;
+        }
+        let changed = keep_feet_above_floor(&src, &mut out);
+        assert_eq!(changed, 2 + 2 * FLOOR_EASE_FRAMES, "{changed}");
+        for f in 0..12 {
+            let p = out.joint_positions(f);
+            assert!(
+                p[3].y.min(p[4].y) >= -CONTACT_HEIGHT - 1e-3,
+                "frame {f}: {p:?}"
+            );
+        }
+        assert_eq!(out.frames[0], src.frames[0]);
+        assert_eq!(out.frames[11], src.frames[11]);
     }
 
     #[test]

@@ -37,7 +37,7 @@
 
 use glam::{Quat, Vec3};
 
-use super::contact::{find_legs, keep_source_contacts};
+use super::contact::{find_legs, keep_feet_above_floor, keep_source_contacts};
 use super::joint_limits::{find_hinges, limit_hinges, JointRanges};
 use super::phrasing::{Phrasing, Stage};
 use crate::motion::{Clip, Pose, Skeleton};
@@ -193,6 +193,7 @@ pub fn apply_effort(
     }
     // A rescaled height flies higher where the source flew, but stands where it stood.
     keep_source_contacts(clip, &mut out);
+    keep_feet_above_floor(clip, &mut out);
     reshape(&mut out, e.weight, forward);
 
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
