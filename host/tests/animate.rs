@@ -268,18 +268,26 @@ fn cyclic_walk_plays_whole_cycles_without_skating() {
         speed: 0.12,
         turn: 0.0,
     }];
+    let mut strides = Vec::new();
     for weight in [0.0, -0.9, 0.9] {
         let (log, mut events) = doodle(&seg, 100.0, 3, 1.0);
         events[0].weight = weight;
         let asm = run(&events, Some(&log));
         let p = &asm.placements[0];
-        // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles; a light
-        // walk takes shorter strides (more cycles), a strong one longer (fewer).
+        // 4 s at 1.2 m/s = 4.8 m; DeepMimic's walk travels 1.24 m a cycle → 4 cycles; a strong
+        // walk takes longer strides (fewer cycles); a light one shorter strides, as many as its
+        // quickest cadence allows (MAX_CADENCE × the clip's: 4 in 4 s), covering less ground.
+        let stride = p.path.length() / p.cycles as f32;
+        eprintln!(
+            "walk Lw={weight}: path {:.2} m, stride {stride:.2} m",
+            p.path.length()
+        );
         match weight {
-            w if w < 0.0 => assert!(p.cycles > 4, "{}", p.cycles),
+            w if w < 0.0 => assert!(p.cycles >= 4, "{}", p.cycles),
             w if w > 0.0 => assert!(p.cycles < 4, "{}", p.cycles),
             _ => assert_eq!(p.cycles, 4, "{}", p.path.length()),
         }
+        strides.push(stride);
         // Planted feet barely slide: horizontal ankle speed while in contact.
         let legs = figurine_host::anim::contact::find_legs(&asm.clip);
         let dt = asm.clip.frame_time;
@@ -302,6 +310,11 @@ fn cyclic_walk_plays_whole_cycles_without_skating() {
         );
         assert!(slide.len() > 20 && median < 0.25, "{median}");
     }
+    // Light steps short, strong steps long.
+    assert!(
+        strides[1] < strides[0] && strides[0] < strides[2],
+        "{strides:?}"
+    );
 }
 
 fn single(action: &str, time: f64, weight: f64) -> Assembly {

@@ -234,6 +234,7 @@ fn synthetic_loop(frames: usize) -> ActionClip {
         clip,
         effort: None,
         alternatives: Vec::new(),
+        ranges: None,
     }
 }
 

@@ -8,7 +8,9 @@
 //! - **in place**: at the character's spot, facing its current heading; the clip's own small
 //!   steps are kept and the doodle's displacement is dropped (the seed's spatial offset);
 //! - **moving, cyclic** (walk, run): whole cycles, as many as fit the path (`round(L / C)`,
-//!   C = the clip's travel per cycle); the root advances along the path by the clip's own
+//!   C = the clip's travel per cycle), within a human range of cadence ([`super::pacing::MAX_CADENCE`]);
+//!   a path longer than that cadence (or [`HUMAN_ROOT_SPEED_M_S`]) covers in the time is
+//!   shrunk about its start (see `pace`); the root advances along the path by the clip's own
 //!   progress (stretched by `L / (m C)`), so feet do not skate; heading = path tangent;
 //! - **moving, not cyclic** (jump): the root stays in place while the clip's own root does
 //!   not travel (anticipation, landing, follow-through) and moves along the path, in step
@@ -23,7 +25,9 @@
 //!   cyclic walks along the path too).
 //!
 //! Actions start at their event's start; an event shorter than its clip allows at
-//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×).
+//! [`MAX_SPEEDUP`] overruns its end (a 0.3 s "turn" does not squeeze a 2.5 s pirouette 8×),
+//! and so does one whose root would move faster than [`HUMAN_ROOT_SPEED_M_S`] even when the
+//! fast stretches borrow time from the slow ones ([`super::effort::EffortClip::paced`]).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
 //! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted
@@ -39,6 +43,7 @@ use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
+use super::pacing::{pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
@@ -169,6 +174,7 @@ impl Placed {
 }
 
 /// Character state carried from one action to the next.
+#[derive(Clone)]
 struct Cursor {
     pos: Vec2,
     heading: Vec2,
@@ -303,27 +309,71 @@ pub fn assemble_guided(
             })
             .clone();
         let applied = residual_effort(effort, variant.as_ref());
-        let ec = apply_effort(&ac.clip, &phrasing, applied, forward, ac.cyclic);
-        let chunk = match &path {
+        let ec = apply_effort(
+            &ac.clip,
+            &phrasing,
+            applied,
+            forward,
+            ac.cyclic,
+            ac.ranges.as_deref(),
+        );
+        let doodled = match &path {
             _ if !ac.moving => Polyline::new(Vec::new()),
             Some(p) => p.chunk(ev.start as f32, ev.end as f32),
             None => natural_path(ac, (ev.end - ev.start) as f32),
         };
+        let (chunk, cycles) = pace(ac, &ec, &doodled, (ev.end - ev.start) as f32);
         // Never faster than MAX_SPEEDUP × the clip (all its cycles): a too-short event overruns
         // into the pause after it (the next action waits if it must).
-        let cycles = cycle_count(ac, &ec, &chunk, (ev.end - ev.start) as f32);
         let min_len = (cycles as f32 * ac.clip.duration() / MAX_SPEEDUP * fps).ceil() as usize;
-        let f1 = frame_of(ev.end).max(f0 + min_len.max(2));
-        if f1 > MAX_OUTPUT_FRAMES {
-            return Err(AnimError::Data(format!(
-                "action {} at {} s would end at frame {f1}, past the {MAX_OUTPUT_FRAMES} frames \
-                 an animation may have",
-                ev.action, ev.start
-            )));
+        let mut f1 = frame_of(ev.end).max(f0 + min_len.max(2));
+        // Nor does any stretch of it move the root faster than a person: the time map gives
+        // such stretches the time they need (see `EffortClip::paced`), per cycle. A gait whose
+        // path is longer than its cycles' travel moves its root that much faster.
+        let stretch = if ac.moving && ac.cyclic {
+            let travel = ec.clip.root_path();
+            let per_cycle = match (travel.first(), travel.last()) {
+                (Some(&a), Some(&b)) => ground(b - a).length(),
+                _ => 0.0,
+            };
+            (chunk.length() / (cycles.max(1) as f32 * per_cycle).max(1e-3)).max(1.0)
+        } else {
+            1.0
+        };
+        let top_speed = HUMAN_ROOT_SPEED_M_S * PACE_HEADROOM;
+        let (ec, cycle_s) = ec.paced(
+            (f1 - f0) as f32 / fps / cycles.max(1) as f32,
+            top_speed / stretch,
+        );
+        f1 = f1.max(f0 + (cycle_s * cycles.max(1) as f32 * fps).ceil() as usize);
+        // Nor faster than a person moves: an action whose root would outrun
+        // HUMAN_ROOT_SPEED_M_S (a short event squeezing a long clip, a sudden retime
+        // compressing a lunge) takes the time it needs, its timing slowed evenly — but never
+        // beyond the clip's own pace (or the event's length, if longer): what is still too
+        // fast then is no matter of timing.
+        let slowest = f1.max(f0 + (cycles as f32 * ac.clip.duration() * fps).ceil() as usize);
+        let start = cursor.clone();
+        let mut placed_action;
+        loop {
+            if f1 > MAX_OUTPUT_FRAMES {
+                return Err(AnimError::Data(format!(
+                    "action {} at {} s would end at frame {f1}, past the {MAX_OUTPUT_FRAMES} \
+                     frames an animation may have",
+                    ev.action, ev.start
+                )));
+            }
+            cursor = start.clone();
+            placed_action = place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+            let fastest = root_speed_max(&placed_action.0, 1.0 / fps);
+            if fastest <= top_speed || f1 >= slowest {
+                break;
+            }
+            let n = (f1 - f0) as f32;
+            let need = (n * fastest / top_speed).ceil().max(n + 1.0) as usize;
+            f1 = (f0 + need).min(slowest);
         }
         let duration = (f1 - f0) as f32 / fps;
-        let (poses, world_path, cycles, src_times) =
-            place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
+        let (poses, world_path, cycles, src_times) = placed_action;
         let src_contacts = source_contacts
             .entry(key)
             .or_insert_with(|| detect_contacts(&ac.clip, &legs))
@@ -699,28 +749,6 @@ fn place_action(
         }
     }
     (poses, world_path, cycles, src_times)
-}
-
-/// Cycles a cyclic moving action plays along `chunk` in `duration` seconds: whole cycles of
-/// the (effort-rescaled) clip's travel, at least one, but no more than fit the duration at
-/// [`MAX_SPEEDUP`] (then strides stretch; pinning keeps planted feet put). A looping clip that
-/// plays in place (or a cyclic one without a path to follow) repeats as many whole times as
-/// fill the duration at its own speed. 1 otherwise (moving, non-cyclic actions play once).
-fn cycle_count(ac: &ActionClip, ec: &EffortClip, chunk: &Polyline, duration: f32) -> usize {
-    let root = ec.clip.root_path();
-    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
-        return 1;
-    };
-    let cycle_len = ground(rl - r0).length();
-    if ac.cyclic && ac.moving && chunk.length() > 0.05 && cycle_len > 0.05 {
-        let by_path = (chunk.length() / cycle_len).round() as usize;
-        let by_time = (duration * MAX_SPEEDUP / ec.clip.duration().max(1e-3)).floor() as usize;
-        by_path.min(by_time).max(1)
-    } else if ac.looping && (!ac.moving || ac.cyclic) && duration.is_finite() {
-        (duration / ac.clip.duration().max(1e-3)).round().max(1.0) as usize
-    } else {
-        1
-    }
 }
 
 /// Rotates a ground vector by a yaw quaternion.

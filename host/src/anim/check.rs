@@ -115,6 +115,10 @@ impl Plausibility {
                 self.knee_backwards_max_deg > e::BENT_BACKWARDS_DEG,
                 "knee backwards",
             ),
+            (
+                self.elbow_backwards_max_deg > e::BENT_BACKWARDS_DEG,
+                "elbow backwards",
+            ),
             (self.root_speed_max > e::ROOT_SPEED_M_S, "root speed"),
         ]
         .into_iter()

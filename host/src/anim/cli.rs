@@ -44,7 +44,9 @@ pub struct AnimateArgs {
     /// Also write a binary glTF (.glb).
     #[arg(long)]
     pub glb: Option<PathBuf>,
-    /// Toy metres → character metres.
+    /// Toy metres → character metres: the size of the doodled path, wherever a person can
+    /// cover it in the doodle's time (a walk or run too fast for that, at this scale, covers a
+    /// shrunk copy of its path).
     #[arg(long, default_value_t = DEFAULT_WORLD_SCALE)]
     pub world_scale: f32,
     /// Output frames per second.

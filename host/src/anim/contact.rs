@@ -115,10 +115,10 @@ pub fn detect_contacts(clip: &Clip, legs: &[Leg]) -> Vec<Vec<bool>> {
 /// Frames over which a pinned foot eases in and out of its pin.
 pub const PIN_EASE_FRAMES: usize = 3;
 
-/// Pins planted feet: for every run of contact frames of a leg, the ankle is held (in the
-/// ground plane) where it was in the run's middle frame, by two-bone IK, easing in and out
-/// over [`PIN_EASE_FRAMES`] frames; its height stays the animation's. Unreachable pins are
-/// approached as far as the leg allows.
+/// Pins planted feet: for every run of contact frames of a leg, the foot's contact point (its
+/// lowest in the run's middle frame) is held (in the ground plane) where it was in that
+/// frame, by two-bone IK, easing in and out over [`PIN_EASE_FRAMES`] frames; its height stays
+/// the animation's. Unreachable pins are approached as far as the leg allows.
 pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
     let sk = clip.skeleton.clone();
     let n = clip.len();
@@ -138,7 +138,18 @@ pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
                 continue;
             }
             let mid = (a + b) / 2;
-            let pin = sk.positions(&clip.frames[mid])[leg.ankle];
+            // The point the foot stands on (its lowest in the run's middle frame) is held,
+            // not the ankle: a foot that pivots about its toes on a pinned ankle still slides
+            // its toes across the floor. IK keeps the foot's orientation, so moving the ankle
+            // by the contact point's slip puts the contact point back.
+            let mid_pos = sk.positions(&clip.frames[mid]);
+            let point = leg
+                .foot
+                .iter()
+                .copied()
+                .min_by(|&i, &j| mid_pos[i].y.total_cmp(&mid_pos[j].y))
+                .unwrap_or(leg.ankle);
+            let pin = mid_pos[point];
             let lo = a.saturating_sub(PIN_EASE_FRAMES);
             let hi = (b + PIN_EASE_FRAMES).min(n - 1);
             for g in lo..=hi {
@@ -150,11 +161,12 @@ pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
                     1.0
                 };
                 let pose = &mut clip.frames[g];
-                let own = sk.positions(pose)[leg.ankle];
+                let world = sk.positions(pose);
+                let (own, at) = (world[leg.ankle], world[point]);
                 let target = Vec3::new(
-                    own.x + (pin.x - own.x) * w,
+                    own.x + (pin.x - at.x) * w,
                     own.y,
-                    own.z + (pin.z - own.z) * w,
+                    own.z + (pin.z - at.z) * w,
                 );
                 if (target - own).length() > 1e-5 {
                     two_bone_ik(&sk, pose, leg, target);
@@ -175,37 +187,48 @@ pub struct GroundFix {
     pub max_depth: f32,
 }
 
-/// The lowest foot point's height in each frame of `clip` (∞ without legs).
-fn lowest_feet(clip: &Clip, legs: &[Leg]) -> Vec<f32> {
+/// Per frame of `clip`, per leg: the height of the foot's lowest point (∞ without points).
+fn foot_heights(clip: &Clip, legs: &[Leg]) -> Vec<Vec<f32>> {
     clip.frames
         .iter()
         .map(|p| {
             let world = clip.skeleton.positions(p);
             legs.iter()
-                .flat_map(|l| l.foot.iter())
-                .filter_map(|&j| world.get(j).map(|w| w.y))
-                .fold(f32::INFINITY, f32::min)
+                .map(|l| {
+                    l.foot
+                        .iter()
+                        .filter_map(|&j| world.get(j).map(|w| w.y))
+                        .fold(f32::INFINITY, f32::min)
+                })
+                .collect()
         })
         .collect()
 }
 
 /// Keeps on the ground the feet that `src` had on it: `out` (the same frames after effort
 /// transfer, which rescales the root's height) is moved up or down, frame by frame, so that
-/// its lowest foot is as high as the source's was wherever the source stood (its lowest foot
-/// within [`CONTACT_HEIGHT`] of the ground); in the air the correction of the frames around is
+/// the foot the source stood on (its lowest, when within [`CONTACT_HEIGHT`] of the ground) is
+/// as high as it was in the source; in the air the correction of the frames around is
 /// blended, so an amplified jump flies higher but takes off and lands where the source did.
+/// The standing foot, not whichever foot is now lowest, sets the height: an amplified kick
+/// swings its free foot through the floor (the ground pass lifts that foot with IK), and
+/// lifting the whole body onto it would pop the character a metre up for a frame.
 /// Returns the largest correction, metres.
 pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
     let legs = find_legs(src);
     if legs.is_empty() || src.len() != out.len() {
         return 0.0;
     }
-    let was = lowest_feet(src, &legs);
-    let now = lowest_feet(out, &legs);
+    let was = foot_heights(src, &legs);
+    let now = foot_heights(out, &legs);
     let grounded: Vec<Option<f32>> = was
         .iter()
         .zip(&now)
-        .map(|(&w, &n)| (w < GROUND_Y + CONTACT_HEIGHT && (w - n).is_finite()).then_some(w - n))
+        .map(|(w, n)| {
+            let (leg, &low) = w.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+            let d = low - n.get(leg)?;
+            (low < GROUND_Y + CONTACT_HEIGHT && d.is_finite()).then_some(d)
+        })
         .collect();
     let mut largest = 0.0f32;
     for (f, pose) in out.frames.iter_mut().enumerate() {
@@ -231,6 +254,92 @@ pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
         largest = largest.max(corr.abs());
     }
     largest
+}
+
+/// Frames either side over which [`keep_feet_above_floor`] spreads a frame's restraint, so
+/// that the rescaling eases off and back on rather than snapping.
+pub const FLOOR_EASE_FRAMES: usize = 4;
+/// Bisection steps of [`keep_feet_above_floor`].
+const FLOOR_BISECTIONS: usize = 10;
+
+/// Where rescaling sends a foot through the floor deeper than [`CONTACT_HEIGHT`] (an
+/// amplified free leg swung down while the standing leg, folded deeper, lowered the body),
+/// draws the legs of `out` back towards `src` (the same frames before effort transfer) just
+/// enough that it does not: per frame the largest share of the change (the legs' rotations
+/// slerped, the root's height interpolated) that keeps every foot above `−CONTACT_HEIGHT`, the smallest share over
+/// [`FLOOR_EASE_FRAMES`] either side applied. The ground pass's IK lifts what a foot may
+/// still sink; deeper, it would fold the knee shut. The floor bounds an amplified swing as
+/// the joints' ranges do. Returns how many frames it drew back.
+pub fn keep_feet_above_floor(src: &Clip, out: &mut Clip) -> usize {
+    let legs = find_legs(src);
+    if legs.is_empty() || src.len() != out.len() {
+        return 0;
+    }
+    // Only the legs are drawn back (and the root's height): the arms keep their effort.
+    let leg_joints: Vec<usize> = legs
+        .iter()
+        .flat_map(|l| [l.hip, l.knee].into_iter().chain(l.foot.iter().copied()))
+        .collect();
+    let blend = |a: &crate::motion::Pose, b: &crate::motion::Pose, s: f32| {
+        let mut p = b.clone();
+        for &j in &leg_joints {
+            if let (Some(q), Some(qa), Some(qb)) = (
+                p.rotations.get_mut(j),
+                a.rotations.get(j),
+                b.rotations.get(j),
+            ) {
+                *q = qa.slerp(*qb, s).normalize();
+            }
+        }
+        if let (Some(t), Some(ta), Some(tb)) = (
+            p.translations.first_mut(),
+            a.translations.first(),
+            b.translations.first(),
+        ) {
+            t.y = ta.y + (tb.y - ta.y) * s;
+        }
+        p
+    };
+    let lowest = |p: &crate::motion::Pose| {
+        let w = out.skeleton.positions(p);
+        legs.iter()
+            .flat_map(|l| l.foot.iter())
+            .filter_map(|&j| w.get(j).map(|v| v.y))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let floor = GROUND_Y - CONTACT_HEIGHT;
+    let share: Vec<f32> = src
+        .frames
+        .iter()
+        .zip(&out.frames)
+        .map(|(a, b)| {
+            if lowest(b) >= floor || lowest(a) < floor {
+                return 1.0;
+            }
+            let (mut ok, mut bad) = (0.0f32, 1.0f32);
+            for _ in 0..FLOOR_BISECTIONS {
+                let mid = 0.5 * (ok + bad);
+                if lowest(&blend(a, b, mid)) >= floor {
+                    ok = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            ok
+        })
+        .collect();
+    let n = share.len();
+    let mut changed = 0;
+    for f in 0..n {
+        let lo = f.saturating_sub(FLOOR_EASE_FRAMES);
+        let hi = (f + FLOOR_EASE_FRAMES).min(n - 1);
+        let s = share[lo..=hi].iter().copied().fold(1.0f32, f32::min);
+        if s < 1.0 {
+            out.frames[f] = blend(&src.frames[f], &out.frames[f], s);
+            changed += 1;
+        }
+    }
+    changed
 }
 
 /// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
@@ -276,9 +385,18 @@ pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
     fix
 }
 
+/// Least forward bend (rad) of a knee before IK bends it further: the solver keeps the side
+/// a knee is bent to, so a straight or overextended knee is first turned this far forward.
+pub const KNEE_FORWARD_RAD: f32 = 0.05;
+
 /// Two-bone IK: rotates hip and knee so the ankle reaches `target` (or as close as the leg
-/// allows), keeping the knee's bending plane and the foot's world orientation.
+/// allows), keeping the knee's bending plane and the foot's world orientation. A knee bends
+/// forward, towards the toes: the solver bends a knee further on the side it is already bent
+/// to, so a knee that is straight or overextended (the shin swung forward of the thigh, as
+/// rescaling or a blend may leave it) is first turned to [`KNEE_FORWARD_RAD`] forward —
+/// else IK would fold it backwards.
 pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, target: Vec3) {
+    bend_knee_forward(sk, pose, leg);
     let world = sk.forward(pose);
     let (a, b, c) = (
         world[leg.hip].position,
@@ -332,6 +450,61 @@ pub fn two_bone_ik(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg, tar
     pose.rotations[leg.ankle] = (knee_world.inverse() * c_gr).normalize();
 }
 
+/// Turns a straight or overextended knee of `leg` to [`KNEE_FORWARD_RAD`] forward (see
+/// [`two_bone_ik`]): in the plane of the thigh and the knee's forward direction, the shin is
+/// swung back until it trails the thigh by that angle. The knee's forward direction is the
+/// toes' in the rest pose (a straight leg, feet forward), carried by the thigh: a hinge's
+/// forward turns with the thigh, not with the foot (pointed toes would say nothing). Legs
+/// without a point beyond the ankle are left alone.
+fn bend_knee_forward(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg) {
+    let rest = sk.positions(&crate::motion::Pose::rest(sk));
+    let Some(toe) = leg
+        .foot
+        .iter()
+        .filter(|&&j| j != leg.ankle)
+        .filter_map(|&j| Some(*rest.get(j)? - *rest.get(leg.ankle)?))
+        .max_by(|x, y| x.length_squared().total_cmp(&y.length_squared()))
+    else {
+        return;
+    };
+    let (Some(&hip0), Some(&knee0)) = (rest.get(leg.hip), rest.get(leg.knee)) else {
+        return;
+    };
+    let Some(u0) = (knee0 - hip0).try_normalize() else {
+        return;
+    };
+    let Some(f0) = (toe - u0 * toe.dot(u0)).try_normalize() else {
+        return;
+    };
+    let world = sk.forward(pose);
+    let (a, b, c) = (
+        world[leg.hip].position,
+        world[leg.knee].position,
+        world[leg.ankle].position,
+    );
+    let Some(u) = (b - a).try_normalize() else {
+        return;
+    };
+    let Some(d) = (c - b).try_normalize() else {
+        return;
+    };
+    let f = world[leg.hip].rotation * f0;
+    let Some(f) = (f - u * f.dot(u)).try_normalize() else {
+        return;
+    };
+    // Signed angle of the shin from the thigh towards the toes: > 0 is overextended.
+    let beta = d.dot(f).atan2(d.dot(u));
+    if beta <= -KNEE_FORWARD_RAD {
+        return;
+    }
+    let Some(axis) = u.cross(-f).try_normalize() else {
+        return;
+    };
+    let b_gr = world[leg.knee].rotation;
+    let turn = Quat::from_axis_angle((b_gr.inverse() * axis).normalize(), beta + KNEE_FORWARD_RAD);
+    pose.rotations[leg.knee] = (pose.rotations[leg.knee] * turn).normalize();
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -375,6 +548,52 @@ mod tests {
         // The pelvis did not move: IK alone did it (the bent knee has slack).
         assert!((after[0] - before[0]).length() < 1e-6);
         assert_eq!(fix.raised_frames, 0);
+    }
+
+    #[test]
+    fn ik_bends_an_overextended_knee_forward_not_further_back() {
+        // The toes point +Z; the shin swung 0.3 rad forward of the thigh (overextended).
+        let c = leg_clip();
+        let legs = find_legs(&c);
+        let mut pose = c.frames[0].clone();
+        pose.rotations[2] = Quat::from_rotation_x(-0.3);
+        let before = c.skeleton.positions(&pose);
+        let target = before[3] + Vec3::Y * 0.15;
+        two_bone_ik(&c.skeleton, &mut pose, &legs[0], target);
+        let p = c.skeleton.positions(&pose);
+        assert!((p[3] - target).length() < 1e-3, "{:?} {target}", p[3]);
+        // The knee stands forward (+Z) of the hip–ankle line.
+        let n = (p[3] - p[1]).normalize();
+        let off = (p[2] - p[1]) - n * (p[2] - p[1]).dot(n);
+        assert!(off.z > 0.02, "knee offset {off}");
+    }
+
+    #[test]
+    fn a_foot_rescaled_through_the_floor_is_drawn_back_and_the_rest_kept() {
+        // The source stands on the ground for 12 frames; the rescaled copy sinks 0.3 m in
+        // frames 5–6 and nowhere else.
+        let base = leg_clip();
+        let mut src = base.clone();
+        src.frames = vec![base.frames[0].clone(); 12];
+        let sink = src.joint_positions(0)[4].y.min(src.joint_positions(0)[3].y);
+        for p in &mut src.frames {
+            p.translations[0].y -= sink;
+        }
+        let mut out = src.clone();
+        for f in [5, 6] {
+            out.frames[f].translations[0].y -= 0.3;
+        }
+        let changed = keep_feet_above_floor(&src, &mut out);
+        assert_eq!(changed, 2 + 2 * FLOOR_EASE_FRAMES, "{changed}");
+        for f in 0..12 {
+            let p = out.joint_positions(f);
+            assert!(
+                p[3].y.min(p[4].y) >= -CONTACT_HEIGHT - 1e-3,
+                "frame {f}: {p:?}"
+            );
+        }
+        assert_eq!(out.frames[0], src.frames[0]);
+        assert_eq!(out.frames[11], src.frames[11]);
     }
 
     #[test]

@@ -21,18 +21,24 @@
 //!   sinking forward, light rising.
 //!
 //! Eq. 7 is applied with each stage's reference chained to the previous stage's rescaled end,
-//! so the rescaled motion stays continuous at stage boundaries; the hinges (knees, elbows) are
-//! then held within the range they bend in ([`super::joint_limits`]), and the frames in which
-//! the source stood are put back on the ground ([`super::contact::keep_source_contacts`]): a
-//! strong jump flies higher, a strong punch does not hover. The root's orientation (the
-//! body's facing and balance) is left alone; its height is rescaled, and its ground travel
-//! too for cyclic clips so that the distance per cycle follows the rescaled stride. Feet that
-//! slide because of rescaling are pinned afterwards by the assembler's contact pass.
+//! so the rescaled motion stays continuous at stage boundaries. Every joint is rescaled only
+//! as far as it stays within the range the library's actors moved it in
+//! ([`super::joint_limits::JointRanges`]; a strong run's hips swing wider, but never into a
+//! split), the hinges (knees, elbows) are then held within the range they bend in
+//! ([`super::joint_limits`]), and the frames in which the source stood are put back on the
+//! ground ([`super::contact::keep_source_contacts`]): a strong jump flies higher, a strong
+//! punch does not hover. The root's orientation (the body's facing and balance) is left
+//! alone; its height is rescaled, and for cyclic clips its ground travel follows the feet's
+//! rescaled sweep ([`stride_ratio`]) so that a cycle covers the distance its legs step.
+//! Cyclic clips (gaits) keep their clock within the cycle; their Time shows in the cadence
+//! (see [`apply_effort`]). Feet that slide because of rescaling are pinned afterwards by the
+//! assembler's contact pass, and [`EffortClip::paced`] keeps a retimed clip's root within
+//! the speed a person moves at.
 
 use glam::{Quat, Vec3};
 
-use super::contact::keep_source_contacts;
-use super::joint_limits::{find_hinges, limit_hinges};
+use super::contact::{find_legs, keep_feet_above_floor, keep_source_contacts};
+use super::joint_limits::{find_hinges, limit_hinges, JointRanges};
 use super::phrasing::{Phrasing, Stage};
 use crate::motion::{Clip, Pose, Skeleton};
 
@@ -42,6 +48,9 @@ pub const ALPHA: f32 = 1.5;
 pub const RESHAPE_RAD: f32 = 0.1;
 /// Floor of the normalised joint speed in the arc-length reparametrisation.
 pub const SPEED_FLOOR: f32 = 0.1;
+/// Bisection steps finding how far a joint may be rescaled within its range (1/256 of the
+/// factor's span).
+const RANGE_BISECTIONS: usize = 8;
 /// Sub-samples per source frame when tabulating time maps.
 const SUBSTEPS: usize = 4;
 
@@ -80,7 +89,7 @@ pub struct EffortClip {
     /// The stages of the source clip.
     pub phrasing: Phrasing,
     /// Monotone table of (w, source seconds), w from 0 to 1.
-    table: Vec<(f32, f32)>,
+    pub(super) table: Vec<(f32, f32)>,
 }
 
 impl EffortClip {
@@ -134,13 +143,23 @@ fn lookup(table: &[(f32, f32)], x: f32, inverse: bool) -> f32 {
 
 /// Applies Time and Weight efforts to a clip with the given phrasing; `forward` is the rig's
 /// facing in its own frame (the clip library's `forward`), which defines the spine's bending axis;
-/// `scale_travel` rescales the root's ground travel with the stride (cyclic clips).
+/// `ranges` (the library's joint ranges, if known) bound every joint after rescaling.
+///
+/// `cyclic` clips (gait cycles) are treated as locomotion: their root's ground travel follows
+/// the rescaled stride — scaled by how much wider or narrower the feet now sweep relative to
+/// the hips ([`stride_ratio`]), so a cycle covers the distance its legs step — and their clock
+/// is left uniform within the cycle. A gait's timing within a step is set by the body's
+/// mechanics (a foot lands when it lands); eq. 6's warp inside every cycle would make the
+/// body lurch from 1 to 8 m/s each step. Their Time shows in the cadence instead: the
+/// assembler fits whole cycles into the doodle's own duration, short for sudden doodles and
+/// long for sustained ones.
 pub fn apply_effort(
     clip: &Clip,
     phrasing: &Phrasing,
     effort: Effort,
     forward: Vec3,
-    scale_travel: bool,
+    cyclic: bool,
+    ranges: Option<&JointRanges>,
 ) -> EffortClip {
     let e = effort.sanitized();
     let mut out = clip.clone();
@@ -164,11 +183,17 @@ pub fn apply_effort(
             (s.start, s.end, time_part * c_w)
         })
         .collect();
-    rescale_stages(clip, &mut out, &factors, scale_travel);
-    // An amplified swing stays a human one: no knee or elbow bent backwards.
+    // An amplified swing stays a human one: every joint within the range the library's actors
+    // moved it in, and no knee or elbow bent backwards.
+    rescale_stages(clip, &mut out, &factors, ranges);
     limit_hinges(&find_hinges(clip), &mut out);
+    if cyclic {
+        let ratio = stride_ratio(clip, &out);
+        scale_travel(clip, &mut out, ratio);
+    }
     // A rescaled height flies higher where the source flew, but stands where it stood.
     keep_source_contacts(clip, &mut out);
+    keep_feet_above_floor(clip, &mut out);
     reshape(&mut out, e.weight, forward);
 
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
@@ -176,11 +201,15 @@ pub fn apply_effort(
     let mean = speeds.iter().sum::<f32>() / speeds.len().max(1) as f32;
     // Output time spent per source second ∝ V^k: k < 0 makes fast parts faster and slow parts
     // slower (strong); 0 < k ≤ 1 evens the speed out (light), k = 1 being uniform speed.
-    let k = if e.weight >= 0.0 {
+    let k = if cyclic {
+        0.0
+    } else if e.weight >= 0.0 {
         -ALPHA * e.weight
     } else {
         (ALPHA * -e.weight).min(1.0)
     };
+    // Cycles keep their own clock (see above): no stage warp either.
+    let lt = if cyclic { 0.0 } else { e.time };
     let mut arc = vec![0.0f32; n];
     for i in 1..n {
         let v = if mean > 1e-9 {
@@ -208,7 +237,7 @@ pub fn apply_effort(
         let mut acc = 0.0;
         for &(stage, a, b) in &bounds {
             let local = (g.min(b) - a).max(0.0);
-            let (ak, bk) = stage_params(stage, e.time);
+            let (ak, bk) = stage_params(stage, lt);
             acc += ak * local.powf(bk);
             if g <= b {
                 break;
@@ -304,7 +333,17 @@ fn quat_pow(q: Quat, c: f32) -> Quat {
 }
 
 /// Eq. 7 per stage, references chained so the result is continuous.
-fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], travel: bool) {
+/// Each joint's rotation is rescaled by `c` unless that leaves its range (`ranges`); then by
+/// the factor between 1 and `c` nearest `c` that keeps it within (bisection on the factor, so
+/// the joint stops where the amplified swing meets the edge of its range rather than being
+/// clamped after the fact, which for a swing amplified past half a turn would flip it to the
+/// opposite side).
+fn rescale_stages(
+    src: &Clip,
+    out: &mut Clip,
+    factors: &[(usize, usize, f32)],
+    ranges: Option<&JointRanges>,
+) {
     let joints = src.skeleton.len();
     let Some(first) = src.frames.first() else {
         return;
@@ -322,24 +361,33 @@ fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], t
                 if j == 0 {
                     // The root's orientation is the body's facing and balance: rescaling it
                     // would over- or under-turn the character and tip it over. Its height is
-                    // rescaled like any translation; its ground travel only for cycles, where
-                    // the distance per cycle follows the rescaled stride (a light walk takes
-                    // shorter steps and, along a given path, more cycles).
+                    // rescaled like any translation; its ground travel is the legs' doing
+                    // (see `scale_travel`).
                     let ts = ref_src.translations[0];
                     let tt = p.translations[0];
-                    let scaled = ref_out.translations[0] + (tt - ts) * c;
-                    if travel {
-                        o.translations[0] = scaled;
-                    } else {
-                        o.translations[0].y = scaled.y;
-                    }
+                    o.translations[0].y = ref_out.translations[0].y + (tt.y - ts.y) * c;
                     continue;
                 }
                 let qs = ref_src.rotations[j];
                 let qt = p.rotations[j];
                 // eq. 7: q(t) = scale(q(s) q(t)^-1, c)^-1 q(s), with q(s) → rescaled reference.
-                let d = quat_pow(qs * qt.inverse(), c);
-                o.rotations[j] = (d.inverse() * ref_out.rotations[j]).normalize();
+                let at = |c: f32| {
+                    (quat_pow(qs * qt.inverse(), c).inverse() * ref_out.rotations[j]).normalize()
+                };
+                let mut q = at(c);
+                if let Some(r) = ranges.filter(|r| !r.contains(j, q) && r.contains(j, at(1.0))) {
+                    let (mut inside, mut outside) = (1.0, c);
+                    for _ in 0..RANGE_BISECTIONS {
+                        let mid = 0.5 * (inside + outside);
+                        if r.contains(j, at(mid)) {
+                            inside = mid;
+                        } else {
+                            outside = mid;
+                        }
+                    }
+                    q = at(inside);
+                }
+                o.rotations[j] = q;
                 let ts = ref_src.translations[j];
                 let tt = p.translations[j];
                 let scaled = ref_out.translations[j] + (tt - ts) * c;
@@ -351,6 +399,57 @@ fn rescale_stages(src: &Clip, out: &mut Clip, factors: &[(usize, usize, f32)], t
         if let Some(end) = out.frames.get(e.min(src.len().saturating_sub(1))) {
             ref_out = end.clone();
         }
+    }
+}
+
+/// How much wider (> 1) or narrower the feet of `out` sweep than those of `src` (the same
+/// frames before rescaling): per leg, the extent of the ankle's position relative to the
+/// hips along the clip's direction of travel, summed over the legs. 1 when the source's feet
+/// do not sweep (or it has no legs, or does not travel).
+pub fn stride_ratio(src: &Clip, out: &Clip) -> f32 {
+    let legs = find_legs(src);
+    let root = src.root_path();
+    let (Some(&r0), Some(&rl)) = (root.first(), root.last()) else {
+        return 1.0;
+    };
+    let Some(dir) = Vec3::new(rl.x - r0.x, 0.0, rl.z - r0.z).try_normalize() else {
+        return 1.0;
+    };
+    let sweep = |c: &Clip| -> f32 {
+        let pos = c.all_positions();
+        legs.iter()
+            .map(|l| {
+                let along = pos.iter().filter_map(|p| {
+                    Some((*p.get(l.ankle)? - *p.first()?).dot(dir)).filter(|v| v.is_finite())
+                });
+                let (lo, hi) = along.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                });
+                if hi >= lo {
+                    hi - lo
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    };
+    let before = sweep(src);
+    if before < 1e-3 {
+        return 1.0;
+    }
+    sweep(out) / before
+}
+
+/// Scales the root's ground travel (from the first frame) of `out` by `ratio`, from that of
+/// `src` (the same frames before rescaling).
+fn scale_travel(src: &Clip, out: &mut Clip, ratio: f32) {
+    let Some(r0) = src.frames.first().map(|p| p.translations[0]) else {
+        return;
+    };
+    for (p, o) in src.frames.iter().zip(&mut out.frames) {
+        let t = p.translations[0];
+        o.translations[0].x = r0.x + (t.x - r0.x) * ratio;
+        o.translations[0].z = r0.z + (t.z - r0.z) * ratio;
     }
 }
 
@@ -480,7 +579,7 @@ mod tests {
             return;
         };
         let ph = detect_stages(&c);
-        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X, false);
+        let e = apply_effort(&c, &ph, Effort::default(), Vec3::X, false, None);
         for (a, b) in e.clip.frames.iter().zip(&c.frames) {
             for (qa, qb) in a.rotations.iter().zip(&b.rotations) {
                 assert!(qa.dot(*qb).abs() > 1.0 - 1e-6);
@@ -511,6 +610,7 @@ mod tests {
                 },
                 Vec3::X,
                 false,
+                None,
             );
             let (a, b) = e.stage_w(Stage::Execution).unwrap();
             b - a
@@ -538,6 +638,7 @@ mod tests {
             },
             Vec3::X,
             false,
+            None,
         );
         let strong = apply_effort(
             &c,
@@ -548,6 +649,7 @@ mod tests {
             },
             Vec3::X,
             false,
+            None,
         );
         let mid = c.len() / 2;
         assert!(spine_tilt(&strong.clip, mid) > spine_tilt(&light.clip, mid));

@@ -14,6 +14,14 @@
 //! |---|---|
 //! | frames turning about the common axis (\|cos\| ≥ [`AXIS_AGREEMENT`]) | ≥ [`AXIS_SHARE`] of those that turn |
 //! | mean bend | ≥ [`MIN_MEAN_BEND_RAD`] |
+//!
+//! Ball joints (hips, shoulders, the spine) have no single axis, but people still move them
+//! within a range: amplifying a run's hip swing twofold about the cycle's first pose splits the
+//! legs nearly 180°, which no runner does. [`JointRanges`] learns each joint's range from the
+//! clip library's own takes — per joint, the box its local rotation (as a rotation vector,
+//! axis × angle) stays in over every frame of every clip — and after effort transfer each
+//! joint is held within it. Pooling the library's takes leaves effort room: a strong run may
+//! lift a knee as high as the kick does, but no hip extends further back than any actor's did.
 
 use glam::{Quat, Vec3};
 
@@ -129,6 +137,81 @@ pub fn limit_hinges(hinges: &[Hinge], clip: &mut Clip) -> usize {
     changed
 }
 
+/// Per joint, the range its local rotation stays in over a set of takes: the box (per
+/// component, radians) of its rotation vector (axis × angle, on the shorter arc). The root's
+/// entry is unused: its rotation is the body's facing.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointRanges {
+    /// Per joint: (least, greatest) rotation-vector components, radians.
+    pub boxes: Vec<(Vec3, Vec3)>,
+}
+
+/// Rotation vector (axis × angle, radians) of `q` on the shorter arc.
+fn rotation_vector(q: Quat) -> Vec3 {
+    let q = if q.w < 0.0 { -q } else { q };
+    q.normalize().to_scaled_axis()
+}
+
+impl JointRanges {
+    /// The ranges of every joint over all frames of `clips` (which share one skeleton; a clip
+    /// with another joint count is skipped). Empty without clips.
+    pub fn learn<'a>(clips: impl IntoIterator<Item = &'a Clip>) -> JointRanges {
+        let mut boxes: Vec<(Vec3, Vec3)> = Vec::new();
+        for clip in clips {
+            let n = clip.skeleton.len();
+            if boxes.is_empty() {
+                boxes = vec![(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); n];
+            }
+            if boxes.len() != n {
+                continue;
+            }
+            for pose in &clip.frames {
+                for (b, q) in boxes.iter_mut().zip(&pose.rotations) {
+                    let v = rotation_vector(*q);
+                    if v.is_finite() {
+                        *b = (b.0.min(v), b.1.max(v));
+                    }
+                }
+            }
+        }
+        JointRanges { boxes }
+    }
+
+    /// Whether joint `joint`'s local rotation `q` lies within its range (true for a joint
+    /// without one).
+    pub fn contains(&self, joint: usize, q: Quat) -> bool {
+        let Some(&(lo, hi)) = self.boxes.get(joint) else {
+            return true;
+        };
+        if !(lo.is_finite() && hi.is_finite()) {
+            return true;
+        }
+        let v = rotation_vector(q);
+        v.cmpge(lo).all() && v.cmple(hi).all()
+    }
+
+    /// Holds every non-root joint of every frame of `clip` within its range; joints without
+    /// a learnt range (none of the takes had frames) are left alone. Returns how many joint
+    /// rotations it changed.
+    pub fn limit(&self, clip: &mut Clip) -> usize {
+        let mut changed = 0;
+        for pose in &mut clip.frames {
+            for (q, &(lo, hi)) in pose.rotations.iter_mut().zip(&self.boxes).skip(1) {
+                if !(lo.is_finite() && hi.is_finite()) {
+                    continue;
+                }
+                let v = rotation_vector(*q);
+                let held = v.clamp(lo, hi);
+                if v.is_finite() && held != v {
+                    *q = Quat::from_scaled_axis(held).normalize();
+                    changed += 1;
+                }
+            }
+        }
+        changed
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,6 +263,35 @@ mod tests {
         let mut deep = leg(&[2.9]);
         limit_hinges(&hinges, &mut deep);
         assert!((bend(&deep, 0) - MAX_BEND_RAD).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_ball_joint_is_held_within_the_range_the_takes_moved_it_in() {
+        // Two takes swing the "knee" 0.1–1.2 rad about +X; a rescaled copy swings it to 2.0
+        // rad and −0.8 rad, and 0.5 rad about +Z, which no take did.
+        let takes = [leg(&[0.1, 0.6]), leg(&[1.2, 0.4])];
+        let ranges = JointRanges::learn(&takes);
+        let mut out = leg(&[2.0, -0.8, 0.7]);
+        out.frames[2].rotations[1] = Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.5);
+        assert_eq!(ranges.limit(&mut out), 3);
+        let v = |f: usize| rotation_vector(out.frames[f].rotations[1]);
+        assert!(
+            (v(0) - Vec3::new(1.2, 0.0, 0.0)).length() < 1e-5,
+            "{}",
+            v(0)
+        );
+        assert!(
+            (v(1) - Vec3::new(0.1, 0.0, 0.0)).length() < 1e-5,
+            "{}",
+            v(1)
+        );
+        assert!(v(2).z.abs() < 1e-5 && v(2).x > 0.6, "{}", v(2));
+        // Within range: untouched.
+        let mut inside = leg(&[0.5]);
+        assert_eq!(ranges.limit(&mut inside), 0);
+        assert!(ranges.contains(1, Quat::from_rotation_x(1.0)));
+        assert!(!ranges.contains(1, Quat::from_rotation_x(1.3)));
+        assert!(JointRanges::learn(std::iter::empty()).boxes.is_empty());
     }
 
     #[test]

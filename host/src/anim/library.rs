@@ -40,12 +40,14 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use glam::Vec3;
 use serde::Deserialize;
 
 use super::clip_spec::check_variants;
 pub use super::clip_spec::{ActionEntry, ActionSpec, MAX_VARIANTS};
+use super::joint_limits::JointRanges;
 use super::AnimError;
 use crate::motion::deepmimic::{humanoid_skeleton, read_deepmimic};
 use crate::motion::urdf::read_urdf_path;
@@ -120,6 +122,10 @@ pub struct ActionClip {
     /// The action's other variants, in library order (empty for a single clip). `self` is the
     /// primary variant.
     pub alternatives: Vec<ActionClip>,
+    /// The range each joint moves in over every take of the library (see
+    /// [`super::joint_limits::JointRanges`]): effort transfer holds the joints within it.
+    /// `None` for clips built outside a library.
+    pub ranges: Option<Arc<JointRanges>>,
 }
 
 impl ActionClip {
@@ -246,6 +252,50 @@ impl ClipLibrary {
     /// each action's primary variant, carrying the others as
     /// [`ActionClip::alternatives`] with their effort estimates.
     pub fn load<'a>(
+        &self,
+        actions: impl IntoIterator<Item = &'a str>,
+    ) -> Result<BTreeMap<String, ActionClip>, AnimError> {
+        let mut out = self.load_clips(actions)?;
+        let ranges = self.joint_ranges(&out);
+        for ac in out.values_mut() {
+            ac.ranges = Some(ranges.clone());
+            for alt in &mut ac.alternatives {
+                alt.ranges = Some(ranges.clone());
+            }
+        }
+        Ok(out)
+    }
+
+    /// The range each joint moves in over every clip the library maps (all variants), learnt
+    /// once per library and kept for the process: an action's effort is held within what the
+    /// library's actors did, whichever other actions an animation holds. Should a clip of
+    /// the library fail to load, the ranges come from `loaded` alone.
+    fn joint_ranges(&self, loaded: &BTreeMap<String, ActionClip>) -> Arc<JointRanges> {
+        static CACHE: OnceLock<Mutex<BTreeMap<String, Arc<JointRanges>>>> = OnceLock::new();
+        let key = format!("{:?}|{:?}|{:?}", self.base, self.skeleton, self.actions);
+        let cache = CACHE.get_or_init(Default::default);
+        if let Some(r) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return r;
+        }
+        let pool = |clips: &BTreeMap<String, ActionClip>| {
+            Arc::new(JointRanges::learn(
+                clips.values().flat_map(|a| a.variants()).map(|v| &v.clip),
+            ))
+        };
+        match self.load_clips(self.actions.keys().map(String::as_str)) {
+            Ok(all) => {
+                let r = pool(&all);
+                if let Ok(mut c) = cache.lock() {
+                    c.insert(key, r.clone());
+                }
+                r
+            }
+            Err(_) => pool(loaded),
+        }
+    }
+
+    /// [`Self::load`] without the joint ranges.
+    fn load_clips<'a>(
         &self,
         actions: impl IntoIterator<Item = &'a str>,
     ) -> Result<BTreeMap<String, ActionClip>, AnimError> {
@@ -378,6 +428,7 @@ impl ClipLibrary {
             source_span_s,
             effort: None,
             alternatives: Vec::new(),
+            ranges: None,
         })
     }
 }

@@ -5,9 +5,10 @@
 //! [`library`] (action → clip variants; an entry's format in [`clip_spec`]) →
 //! [`variants`] (the variant matching the recognised effort) →
 //! [`phrasing`] (stages of each clip, §6.1) →
-//! [`effort`] (retime eq. 6, rescale eq. 7 within the hinges' range ([`joint_limits`]), weight
-//! arc length, reshape; §6.3–6.4) →
+//! [`effort`] (retime eq. 6, rescale eq. 7 within the joints' ranges learnt from the library
+//! and the hinges' ([`joint_limits`]), weight arc length, reshape; §6.3–6.4) →
 //! [`trajectory`] (doodle → ground path, in-place offsets, cycles, jumps; §6.2) →
+//! [`pacing`] (cycles at a human cadence, paths and retimes no faster than a person) →
 //! [`looping`] (seamless repeats of looping clips) →
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
 //! [`contact`] (foot contacts, two-bone IK against ground penetration) →
@@ -32,6 +33,7 @@ pub mod graph_cuts;
 pub mod joint_limits;
 pub mod library;
 pub mod looping;
+pub mod pacing;
 pub mod phrasing;
 pub mod plot;
 pub mod trajectory;

@@ -4,7 +4,10 @@
 //! The figurine's position (metres, +Y up) is projected onto the ground plane (x, z), taken
 //! relative to the first sample and multiplied by the world scale (default
 //! [`DEFAULT_WORLD_SCALE`]: a 15 cm figurine stands for a 1.7 m character, so toy metres ×
-//! 10 ≈ character metres; `--world-scale` overrides it). Each action's path starts where the
+//! 10 ≈ character metres; `--world-scale` overrides it). The scale sets the path's size
+//! wherever a person can cover it in the doodle's time: a moving action whose path would need
+//! a faster pace than its gait allows has its path shrunk about its start (the assembler's
+//! `pace`), the doodle's shape and timing kept. Each action's path starts where the
 //! character stands: the doodle's displacement during in-place actions and between actions
 //! is dropped, which is the seed's spatial offset `s_off`.
 

@@ -303,6 +303,7 @@ mod tests {
             source_span_s: (0.0, 2.0),
             effort: None,
             alternatives: Vec::new(),
+            ranges: None,
         }
     }
 
