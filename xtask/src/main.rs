@@ -1,8 +1,8 @@
 //! `cargo xtask`: figurine's build automation.
 //!
 //! * `setup` — installs what a fresh Debian machine needs (idempotent).
-//! * `test` — setup, then every check: fmt, clippy, host tests, no_std checks for the thumb
-//!   target, firmware builds for every board, end-to-end tests.
+//! * `test` — setup, then every check: fmt, import circles, clippy, host tests, no_std checks
+//!   for the thumb target, firmware builds for every board, end-to-end tests.
 //! * `demo` — the main job: a doodle recognised, animated, rendered (target/demo/).
 //! * `bench` — prints every figure (sizes, speed, accuracy, instructions, render, graph).
 //! * `e2e` — the firmware in QEMU against the host.
@@ -15,6 +15,7 @@ mod bench;
 mod data;
 mod demo;
 mod fuzz;
+mod modules;
 mod setup;
 mod tasks;
 mod util;

@@ -141,6 +141,9 @@ pub fn test() -> Result<()> {
     step("rustfmt");
     run(cargo().args(["fmt", "--all", "--", "--check"]))?;
 
+    step("import circles");
+    crate::modules::check(&root())?;
+
     step("no_std crates for thumbv7em-none-eabihf");
     for (krate, features) in NO_STD_CRATES {
         run(cargo().args([

@@ -13,7 +13,7 @@
 //! | elbow bent backwards | in the upper arm's frame, the bend about the opposite of the axis the elbow folds about when well bent over the clip: max | ° |
 //! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
 //!
-//! Lengths are read in metres; a file whose body is over [`crate::recognize::doodle::CENTIMETRE_HEIGHT`]
+//! Lengths are read in metres; a file whose body is over [`crate::motion::CENTIMETRE_HEIGHT`]
 //! units tall is read in centimetres. The ground is the plane y = 0 (the project's
 //! animations stand on it), or estimated as a low percentile of the feet's height
 //! ([`Ground::Auto`]) for takes recorded elsewhere. Landmarks come from
@@ -27,8 +27,8 @@ use glam::{Quat, Vec3};
 use serde::Serialize;
 
 use crate::graph::roles::{Role, RoleMap, RoleOverrides};
+use crate::motion::CENTIMETRE_HEIGHT;
 use crate::motion::{Clip, Skeleton};
-use crate::recognize::doodle::CENTIMETRE_HEIGHT;
 
 /// Height of a foot's lowest point under which it is in ground contact, m.
 pub const CONTACT_M: f32 = 0.025;
@@ -39,23 +39,7 @@ pub const SKATE_M_S: f32 = 0.10;
 /// Percentile of the feet's lowest height taken as the ground by [`Ground::Auto`].
 pub const AUTO_GROUND_PERCENTILE: f32 = 0.05;
 
-/// The envelope of real motion capture an animation must stay within (issue 29's goals). Of
-/// the 21 real takes `cargo xtask setup` fetches, 10 sit within it, every person walking,
-/// dancing or kneeling but one just out; the rest leave it by pivoting or sliding feet, floor
-/// work and acrobatics (`figurine check --reference`).
-pub mod envelope {
-    /// Deepest foot penetration, mm.
-    pub const PENETRATION_MM: f32 = 20.0;
-    /// Longest time with no foot near the ground, s: a jump's flight (DeepMimic's standing
-    /// long jump 0.38 s, its backflip 0.44 s).
-    pub const AIRBORNE_S: f32 = 0.5;
-    /// Median speed of a foot in contact, cm/s.
-    pub const SKATE_CM_S: f32 = 10.0;
-    /// A knee or an elbow bent backwards, °.
-    pub const BENT_BACKWARDS_DEG: f32 = 15.0;
-    /// Root speed, m/s: the fastest real take fetched (DeepMimic's run, 4.2 m/s).
-    pub const ROOT_SPEED_M_S: f32 = 4.2;
-}
+pub use super::envelope;
 
 /// Where the ground is.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -11,7 +11,7 @@ use super::phrasing::detect_stages;
 use super::plot::save_contact_sheet;
 use super::trajectory::DEFAULT_WORLD_SCALE;
 use crate::events::{read_events_path, ActionRecord};
-use crate::motion::{read_bvh_path, read_deepmimic_path, write_bvh_path, write_glb_path, Clip};
+use crate::motion::{read_take, write_bvh_path, write_glb_path, Clip};
 use crate::poselog::PoseLog;
 
 /// `figurine animate`: assemble a character animation from recognised actions and the doodle.
@@ -341,14 +341,8 @@ pub fn load_named_clip(
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("bvh") => Ok((read_bvh_path(p)?.clip, false)),
-        Some("txt") | Some("json") if p.is_file() => {
-            let urdf = match urdf {
-                Some(u) => u.to_path_buf(),
-                None => crate::data::require_data_file("deepmimic", "humanoid.urdf")?,
-            };
-            Ok((read_deepmimic_path(p, &urdf)?.clip, false))
-        }
+        Some("bvh") => Ok((read_take(p, urdf)?, false)),
+        Some("txt") | Some("json") if p.is_file() => Ok((read_take(p, urdf)?, false)),
         _ => {
             let lib = match clips {
                 Some(c) => ClipLibrary::read_path(c)?,

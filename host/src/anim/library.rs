@@ -48,7 +48,9 @@ use serde::Deserialize;
 use super::clip_spec::check_variants;
 pub use super::clip_spec::{ActionEntry, ActionSpec, MAX_VARIANTS};
 use super::joint_limits::JointRanges;
+use super::variant_effort::variant_efforts;
 use super::AnimError;
+use crate::graph::GraphError;
 use crate::motion::deepmimic::{humanoid_skeleton, read_deepmimic};
 use crate::motion::urdf::read_urdf_path;
 use crate::motion::{read_bvh_path, Clip, Skeleton};
@@ -341,7 +343,7 @@ impl ClipLibrary {
                 loaded.push(ac);
             }
             if loaded.len() > 1 {
-                super::variants::sign_variants(&mut loaded).map_err(|e| {
+                sign_variants(&mut loaded).map_err(|e| {
                     AnimError::Data(format!(
                         "{}: action {action}: effort features of its variants: {e}",
                         self.origin
@@ -463,6 +465,23 @@ fn select_frames(
         return Err(AnimError::Data(format!(
             "{origin}: action {action}: clip has fewer than 2 frames"
         )));
+    }
+    Ok(())
+}
+
+/// Sets every variant's [`ActionClip::effort`] from its own LMA measurements, standardised over
+/// all the variants' windows ([`variant_efforts`]).
+pub(crate) fn sign_variants(variants: &mut [ActionClip]) -> Result<(), GraphError> {
+    let clips: Vec<Clip> = variants
+        .iter()
+        .map(|v| {
+            let mut c = v.clip.clone();
+            c.name = format!("{} variant {}", v.action, v.variant);
+            c
+        })
+        .collect();
+    for (v, e) in variants.iter_mut().zip(variant_efforts(&clips)?) {
+        v.effort = e;
     }
     Ok(())
 }

@@ -3,7 +3,8 @@
 //!
 //! Data flow, one file per stage:
 //! [`library`] (action → clip variants; an entry's format in [`clip_spec`]) →
-//! [`variants`] (the variant matching the recognised effort) →
+//! [`variants`] (the variant matching the recognised effort, each variant's own effort measured
+//! by [`variant_effort`]) →
 //! [`phrasing`] (stages of each clip, §6.1) →
 //! [`effort`] (retime eq. 6, rescale eq. 7 within the joints' ranges learnt from the library
 //! and the hinges' ([`joint_limits`]), weight arc length, reshape; §6.3–6.4) →
@@ -14,7 +15,8 @@
 //! [`contact`] (foot contacts, two-bone IK against ground penetration) →
 //! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
 //! [`plot`] draws contact sheets to look at the result; [`check`] (`figurine check`) judges
-//! it against real motion capture (penetration, floating, skating, joints bent backwards).
+//! it against real motion capture (penetration, floating, skating, joints bent backwards)
+//! within the bounds of [`envelope`], which [`pacing`] holds a path to as well.
 
 use std::path::PathBuf;
 
@@ -29,6 +31,7 @@ pub mod clip_spec;
 pub mod contact;
 pub mod defaults;
 pub mod effort;
+pub mod envelope;
 pub mod graph_cuts;
 pub mod joint_limits;
 pub mod library;
@@ -38,6 +41,7 @@ pub mod phrasing;
 pub mod plot;
 pub mod trajectory;
 pub mod transition;
+pub mod variant_effort;
 pub mod variants;
 
 /// Why an animation could not be assembled.

@@ -24,9 +24,9 @@ pub const MAX_CADENCE: f32 = 1.5;
 
 /// The fastest a character's root may move, m/s: the fastest real take the project fetches
 /// (DeepMimic's run, 4.2 m/s), the same limit `figurine check` judges against
-/// ([`super::check::envelope::ROOT_SPEED_M_S`]). No person's hips outrun it; an action that
+/// ([`super::envelope::ROOT_SPEED_M_S`]). No person's hips outrun it; an action that
 /// would is given more time.
-pub const HUMAN_ROOT_SPEED_M_S: f32 = super::check::envelope::ROOT_SPEED_M_S;
+pub const HUMAN_ROOT_SPEED_M_S: f32 = super::envelope::ROOT_SPEED_M_S;
 
 /// Share of [`HUMAN_ROOT_SPEED_M_S`] an action is paced to: the passes after placement (the
 /// ground pass raising a root whose leg cannot reach, blends between actions) move the root

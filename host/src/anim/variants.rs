@@ -19,17 +19,9 @@
 //! whichever side rounding favours. Ties go to the earlier variant, so the choice is
 //! deterministic.
 
-use std::path::Path;
-
 use super::graph_cuts::GraphGuide;
 use super::library::ActionClip;
 use crate::graph::effort::{rank_spans_by_effort, Effort};
-use crate::graph::lma::{clip_measurements, MEASUREMENTS};
-use crate::graph::roles::RoleOverrides;
-use crate::graph::source::prepare;
-use crate::graph::style::Standardiser;
-use crate::graph::{GraphError, Role, WINDOW};
-use crate::motion::Clip;
 
 /// How much better (in match units, [0, 1]) another variant must match the recognised effort
 /// than the primary to replace it (0.05 = a summed |ΔLt| + |ΔLw| of 0.2).
@@ -50,66 +42,6 @@ pub struct VariantChoice {
     pub by_graph: bool,
     /// Number of variants the action has.
     pub of: usize,
-}
-
-/// LMA measurement rows (`windows × MEASUREMENTS`, flat) of a clip, after the graph's
-/// analysis normalisation (30 fps, 1.7 m body, floor at 0). Clips shorter than a window are
-/// extended by playing them back and forth.
-pub fn clip_rows(clip: &Clip) -> Result<Vec<f32>, GraphError> {
-    let g = prepare(clip.clone(), Path::new(&clip.name), &RoleOverrides::new())?;
-    let mut points: Vec<[glam::Vec3; Role::COUNT]> = g.points;
-    if points.len() < 2 {
-        return Err(GraphError::format(
-            &clip.name,
-            "fewer than 2 frames to measure",
-        ));
-    }
-    let base = points.clone();
-    let mut backwards = true;
-    while points.len() < WINDOW {
-        let seq: Vec<_> = if backwards {
-            base.iter().rev().skip(1).copied().collect()
-        } else {
-            base.iter().skip(1).copied().collect()
-        };
-        points.extend(seq);
-        backwards = !backwards;
-    }
-    Ok(clip_measurements(&points))
-}
-
-/// Sets every variant's [`ActionClip::effort`] from its own LMA measurements, standardised over
-/// all the variants' windows.
-pub fn sign_variants(variants: &mut [ActionClip]) -> Result<(), GraphError> {
-    let rows: Vec<Vec<f32>> = variants
-        .iter()
-        .map(|v| {
-            let mut c = v.clip.clone();
-            c.name = format!("{} variant {}", v.action, v.variant);
-            clip_rows(&c)
-        })
-        .collect::<Result<_, _>>()?;
-    let all: Vec<f32> = rows.iter().flatten().copied().collect();
-    let st = Standardiser::fit(&all);
-    for (v, r) in variants.iter_mut().zip(&rows) {
-        v.effort = mean_effort(r, &st);
-    }
-    Ok(())
-}
-
-/// Mean effort of measurement rows.
-fn mean_effort(rows: &[f32], st: &Standardiser) -> Option<Effort> {
-    let (mut t, mut w, mut n) = (0.0f32, 0.0f32, 0usize);
-    for row in rows.chunks_exact(MEASUREMENTS) {
-        let e = Effort::of_measurements(row, st);
-        t += e.time;
-        w += e.weight;
-        n += 1;
-    }
-    (n > 0).then(|| Effort {
-        time: t / n as f32,
-        weight: w / n as f32,
-    })
 }
 
 /// The variant of `ac`'s action whose effort best matches `want` (Lt, Lw ∈ [−1, 1]; non-finite
@@ -207,7 +139,10 @@ fn pick(scored: &[(usize, f32, Effort)]) -> Option<(usize, f32, Effort)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::{Joint, Pose, Skeleton};
+    use crate::anim::library::sign_variants;
+    use crate::anim::variant_effort::clip_rows;
+    use crate::graph::lma::MEASUREMENTS;
+    use crate::motion::{Clip, Joint, Pose, Skeleton};
     use glam::{Quat, Vec3};
     use std::path::PathBuf;
 

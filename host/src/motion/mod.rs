@@ -28,6 +28,33 @@ pub use deepmimic::{read_deepmimic_path, DeepMimicClip};
 pub use gltf_export::{write_glb_bytes, write_glb_path};
 pub use skeleton::{Axis, Channel, Joint, RotationOrder, Skeleton};
 
+/// Body height (in the file's unit) above which a take is read as centimetres: no performer
+/// is 3 m tall, and no one is 3 cm.
+pub const CENTIMETRE_HEIGHT: f32 = 3.0;
+
+/// Reads a motion-capture take: a `.bvh` file, or a DeepMimic clip (`.txt` or `.json`) read on
+/// `urdf` (default: the humanoid URDF `cargo xtask setup` fetches).
+pub fn read_take(path: &Path, urdf: Option<&Path>) -> anyhow::Result<Clip> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("bvh") => Ok(read_bvh_path(path)?.clip),
+        Some("txt") | Some("json") => {
+            let urdf = match urdf {
+                Some(u) => u.to_path_buf(),
+                None => crate::data::require_data_file("deepmimic", "humanoid.urdf")?,
+            };
+            Ok(read_deepmimic_path(path, &urdf)?.clip)
+        }
+        _ => anyhow::bail!(
+            "{}: not a motion-capture take (.bvh, or a DeepMimic .txt or .json)",
+            path.display()
+        ),
+    }
+}
+
 /// Why motion data could not be read or written.
 #[derive(Debug, Error)]
 pub enum MotionError {

@@ -24,12 +24,8 @@ use clap::Args;
 use glam::{Mat3, Quat, Vec3};
 
 use crate::graph::roles::{Role, RoleMap, RoleOverrides};
-use crate::motion::{Clip, Skeleton};
+use crate::motion::{Clip, Skeleton, CENTIMETRE_HEIGHT};
 use crate::poselog::{PoseLog, PoseSample};
-
-/// Body height (in the file's unit) above which a take is read as centimetres: no performer
-/// is 3 m tall, and no one is 3 cm.
-pub const CENTIMETRE_HEIGHT: f32 = 3.0;
 
 /// How a take becomes a doodle.
 #[derive(Debug, Clone, PartialEq)]
@@ -229,7 +225,7 @@ pub struct DoodleArgs {
 
 /// Runs `figurine doodle`.
 pub fn run(a: &DoodleArgs) -> Result<()> {
-    let (clip, _) = crate::anim::cli::load_named_clip(&a.from.to_string_lossy(), None, None)?;
+    let clip = crate::motion::read_take(&a.from, None)?;
     let spec = DoodleSpec {
         joint: a.joint.clone(),
         span: (a.start, a.end),

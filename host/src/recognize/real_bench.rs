@@ -113,7 +113,7 @@ pub fn take_doodle(t: &RealTake) -> Result<(Doodle, Labels)> {
             path.display()
         );
     }
-    let (clip, _) = crate::anim::cli::load_named_clip(&path.to_string_lossy(), None, None)?;
+    let clip = crate::motion::read_take(&path, None)?;
     let spec = DoodleSpec {
         joint: t.joint.clone(),
         span: (t.start, t.end),
