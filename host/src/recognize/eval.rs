@@ -545,10 +545,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn label(action: &str, start: f64, end: f64) -> Label {
+    /// A sudden-strong label of `action` over `start..end` s.
+    pub(crate) fn label(action: &str, start: f64, end: f64) -> Label {
         Label {
             action: action.into(),
             start,
@@ -558,7 +559,8 @@ mod tests {
         }
     }
 
-    fn ev(action: &str, start: f64, end: f64) -> Ev {
+    /// An event of `action` over `start..end` s, decided at its end.
+    pub(crate) fn ev(action: &str, start: f64, end: f64) -> Ev {
         Ev {
             action: action.into(),
             start,

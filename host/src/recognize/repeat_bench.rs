@@ -230,28 +230,7 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::{TimeClass, WeightClass};
-
-    fn label(action: &str, start: f64, end: f64) -> Label {
-        Label {
-            action: action.into(),
-            start,
-            end,
-            time_class: TimeClass::Sudden,
-            weight_class: WeightClass::Strong,
-        }
-    }
-
-    fn ev(action: &str, start: f64, end: f64) -> Ev {
-        Ev {
-            action: action.into(),
-            start,
-            end,
-            decided: end,
-            time: 0.0,
-            weight: 0.0,
-        }
-    }
+    use crate::recognize::eval::tests::{ev, label};
 
     #[test]
     fn a_bout_of_a_continuing_action_is_one_label_and_one_shot_repeats_are_each_one() {
