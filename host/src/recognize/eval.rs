@@ -13,8 +13,8 @@
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
 //!
-//! Benchmarks: `figurine eval rest` ([`super::rest_bench`], false alarms per hour at rest) and
-//! `figurine eval sweep` ([`super::sweep`], accuracy as noise, rate or scale is swept).
+//! The benchmarks (`figurine eval rest | sweep | real | repeat`) are dispatched by
+//! [`super::eval_cli`], each in its own module; they use what is here.
 
 use std::path::PathBuf;
 
