@@ -257,8 +257,8 @@ impl ClipLibrary {
         &self,
         actions: impl IntoIterator<Item = &'a str>,
     ) -> Result<BTreeMap<String, ActionClip>, AnimError> {
-        let mut out = self.load_clips(actions)?;
-        let ranges = self.joint_ranges(&out);
+        let wanted: Vec<&str> = actions.into_iter().collect();
+        let (mut out, ranges) = self.with_joint_ranges(&wanted)?;
         for ac in out.values_mut() {
             ac.ranges = Some(ranges.clone());
             for alt in &mut ac.alternatives {
@@ -268,31 +268,42 @@ impl ClipLibrary {
         Ok(out)
     }
 
-    /// The range each joint moves in over every clip the library maps (all variants), learnt
-    /// once per library and kept for the process: an action's effort is held within what the
-    /// library's actors did, whichever other actions an animation holds. Should a clip of
-    /// the library fail to load, the ranges come from `loaded` alone.
-    fn joint_ranges(&self, loaded: &BTreeMap<String, ActionClip>) -> Arc<JointRanges> {
+    /// The `wanted` actions' clips, and the range each joint moves in over every clip the
+    /// library maps (all variants), learnt once per library and kept for the process: an
+    /// action's effort is held within what the library's actors did, whichever other actions
+    /// an animation holds. The first time, every clip is loaded once and the wanted ones taken
+    /// from them; should a clip of the library fail to load, the ranges come from the wanted
+    /// clips alone.
+    fn with_joint_ranges(
+        &self,
+        wanted: &[&str],
+    ) -> Result<(BTreeMap<String, ActionClip>, Arc<JointRanges>), AnimError> {
         static CACHE: OnceLock<Mutex<BTreeMap<String, Arc<JointRanges>>>> = OnceLock::new();
         let key = format!("{:?}|{:?}|{:?}", self.base, self.skeleton, self.actions);
         let cache = CACHE.get_or_init(Default::default);
         if let Some(r) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
-            return r;
+            return Ok((self.load_clips(wanted.iter().copied())?, r));
         }
         let pool = |clips: &BTreeMap<String, ActionClip>| {
             Arc::new(JointRanges::learn(
                 clips.values().flat_map(|a| a.variants()).map(|v| &v.clip),
             ))
         };
+        self.check_actions(wanted.iter().copied())?;
         match self.load_clips(self.actions.keys().map(String::as_str)) {
-            Ok(all) => {
+            Ok(mut all) => {
                 let r = pool(&all);
                 if let Ok(mut c) = cache.lock() {
                     c.insert(key, r.clone());
                 }
-                r
+                let out = wanted.iter().filter_map(|w| all.remove_entry(*w)).collect();
+                Ok((out, r))
             }
-            Err(_) => pool(loaded),
+            Err(_) => {
+                let out = self.load_clips(wanted.iter().copied())?;
+                let r = pool(&out);
+                Ok((out, r))
+            }
         }
     }
 
