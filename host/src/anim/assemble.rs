@@ -43,7 +43,7 @@ use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
-use super::pacing::{pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
+use super::pacing::{ground_travel, pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, smoothstep};
@@ -331,11 +331,7 @@ pub fn assemble_guided(
         // such stretches the time they need (see `EffortClip::paced`), per cycle. A gait whose
         // path is longer than its cycles' travel moves its root that much faster.
         let stretch = if ac.moving && ac.cyclic {
-            let travel = ec.clip.root_path();
-            let per_cycle = match (travel.first(), travel.last()) {
-                (Some(&a), Some(&b)) => ground(b - a).length(),
-                _ => 0.0,
-            };
+            let per_cycle = ground_travel(&ec.clip);
             (chunk.length() / (cycles.max(1) as f32 * per_cycle).max(1e-3)).max(1.0)
         } else {
             1.0
@@ -600,11 +596,7 @@ fn initial_heading(doodle: Option<&PoseLog>) -> Vec2 {
 
 /// Without a doodle, moving actions travel as far as their clip does, straight ahead.
 fn natural_path(ac: &ActionClip, duration: f32) -> Polyline {
-    let root = ac.clip.root_path();
-    let travel = match (root.first(), root.last()) {
-        (Some(a), Some(b)) => ground(*b - *a).length(),
-        _ => 0.0,
-    };
+    let travel = ground_travel(&ac.clip);
     let len = if ac.cyclic {
         let cycles = (duration / ac.clip.duration().max(1e-3)).round().max(1.0);
         travel * cycles

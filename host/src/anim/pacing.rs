@@ -15,7 +15,7 @@ use glam::Vec3;
 use super::effort::EffortClip;
 use super::library::ActionClip;
 use super::trajectory::{ground, Polyline};
-use crate::motion::Pose;
+use crate::motion::{Clip, Pose};
 
 /// How many times more (or fewer) steps a gait may take per second than its clip does. People
 /// walk at about 70–140 steps a minute and run at 150–230 (a sprint), about 1.5× either side
@@ -32,6 +32,16 @@ pub const HUMAN_ROOT_SPEED_M_S: f32 = super::envelope::ROOT_SPEED_M_S;
 /// ground pass raising a root whose leg cannot reach, blends between actions) move the root
 /// by a few millimetres more per frame, so pacing to the limit itself would end just over it.
 pub const PACE_HEADROOM: f32 = 0.97;
+
+/// Ground distance (m) a clip's root travels from its first frame to its last: a cycle's travel
+/// for a gait, a jump's reach.
+pub(super) fn ground_travel(clip: &Clip) -> f32 {
+    let root = clip.root_path();
+    match (root.first(), root.last()) {
+        (Some(&r0), Some(&rl)) => ground(rl - r0).length(),
+        _ => 0.0,
+    }
+}
 
 /// The path a moving action covers in `duration` seconds and the cycles it plays on it, at a
 /// pace a person keeps.
@@ -56,11 +66,7 @@ pub(super) fn pace(
     chunk: &Polyline,
     duration: f32,
 ) -> (Polyline, usize) {
-    let root = ec.clip.root_path();
-    let travel = match (root.first(), root.last()) {
-        (Some(&r0), Some(&rl)) => ground(rl - r0).length(),
-        _ => 0.0,
-    };
+    let travel = ground_travel(&ec.clip);
     let cycle_s = ec.clip.duration().max(1e-3);
     let len = chunk.length();
     if ac.moving && ac.cyclic && len > 0.05 && travel > 0.05 && duration.is_finite() {
