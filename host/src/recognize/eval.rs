@@ -409,6 +409,11 @@ pub fn evaluate(
                 used[i] = true;
                 matched += 1;
                 f.latencies.push(evs[i].decided - l.end);
+            } else if args.verbose {
+                eprintln!(
+                    "  sequence {k}: missed {} {:.2}-{:.2}",
+                    l.action, l.start, l.end
+                );
             }
         }
         for (e, _) in evs.iter().zip(&used).filter(|(_, u)| !**u) {
