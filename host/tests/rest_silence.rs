@@ -4,6 +4,7 @@
 
 use figurine_host::link::blobs::{self, Blobs};
 use figurine_host::poselog::PoseLog;
+use figurine_host::recognize::feed::{log_samples, Clock};
 use figurine_host::recognize::library::LibraryFile;
 use figurine_host::recognize::simulate::simulate_log;
 use figurine_host::synth::knobs::{Knobs, Range};
@@ -11,7 +12,7 @@ use figurine_host::synth::{
     gesture, rest_log, Action, Effort, RestKind, RestSpec, TimeClass, TrackerLevel, WeightClass,
     TRACKER_LEVELS,
 };
-use figurine_recognizer::EffortModel;
+use figurine_recognizer::{EffortModel, Library, Recognizer};
 
 fn shipped() -> (Blobs, EffortModel) {
     let b = blobs::load(None, None).expect("shipped library and effort model");
@@ -114,14 +115,26 @@ fn fidgets_that_spell_an_action_are_no_action() {
     }
 }
 
-/// The decision latency (s) of the first event, and its action.
-fn first_event(log: &figurine_host::poselog::PoseLog, b: &Blobs, e: EffortModel) -> (String, f64) {
-    let sim = simulate_log(log, &b.names, &b.library, Some(e)).unwrap();
-    let ev = sim.events.first().expect("an event");
-    let rec = sim.records.first().expect("a record");
+/// The first event the device reports on `d`: its action, and when it was decided relative
+/// to the end of the labelled gesture (s; negative while the gesture is still going on). The
+/// first report is what a child sees; a later revision (a walk read on by its next stride)
+/// only extends it.
+fn first_report(d: &figurine_host::synth::Doodle, b: &Blobs, e: EffortModel) -> (String, f64) {
+    let lib = Library::from_bytes(&b.library).expect("library blob");
+    let mut rec = Recognizer::new(lib, Some(e));
+    let (samples, _) = log_samples(&d.log);
+    let clock = Clock::new(&d.log, &samples);
+    let mut first = None;
+    for (_, s) in &samples {
+        rec.push(s, |ev| {
+            first.get_or_insert(ev);
+        });
+    }
+    let ev = first.expect("an event");
+    let end = d.labels.first().expect("a label").end;
     (
-        rec.action.clone(),
-        (ev.decided_us.saturating_sub(ev.end_us)) as f64 * 1e-6,
+        b.names[usize::from(ev.action)].clone(),
+        clock.time_of(ev.decided_seq) - end,
     )
 }
 
@@ -137,14 +150,14 @@ fn a_gesture_after_a_long_noisy_rest_is_read_as_quickly() {
         };
         let short = gesture(seed, &knobs(1.0), action, strong);
         let long = gesture(seed, &knobs(60.0), action, strong);
-        let (a, quick) = first_event(&short.log, &b, effort);
-        let (c, late) = first_event(&long.log, &b, effort);
+        let (a, quick) = first_report(&short, &b, effort);
+        let (c, late) = first_report(&long, &b, effort);
         assert_eq!(a, action.name(), "after 1 s of rest");
         assert_eq!(c, action.name(), "after a minute of rest");
         assert!(
             late <= quick + 0.05,
-            "{action:?}: decided {late:.3} s after its end after a minute of rest, {quick:.3} s \
-             after a second"
+            "{action:?}: first reported {late:.3} s after its end after a minute of rest, \
+             {quick:.3} s after a second"
         );
     }
 }
