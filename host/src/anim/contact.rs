@@ -606,22 +606,23 @@ mod tests {
 
     #[test]
     fn a_foot_rescaled_through_the_floor_is_drawn_back_and_the_rest_kept() {
-        // The source stands on the ground for 12 frames; the rescaled copy sinks 0.3 m in
-        // frames 5–6 and nowhere else.
+        // The source stands on the ground for 20 frames; the rescaled copy sinks 0.3 m in
+        // frames 9–10 and nowhere else.
         let base = leg_clip();
         let mut src = base.clone();
-        src.frames = vec![base.frames[0].clone(); 12];
+        src.frames = vec![base.frames[0].clone(); 20];
         let sink = src.joint_positions(0)[4].y.min(src.joint_positions(0)[3].y);
         for p in &mut src.frames {
             p.translations[0].y -= sink;
         }
         let mut out = src.clone();
-        for f in [5, 6] {
+        for f in [9, 10] {
             out.frames[f].translations[0].y -= 0.3;
         }
         let changed = keep_feet_above_floor(&src, &mut out);
-        assert_eq!(changed, 2 + 2 * FLOOR_EASE_FRAMES, "{changed}");
-        for f in 0..12 {
+        // The restraint eases in and out over twice FLOOR_EASE_FRAMES either side.
+        assert_eq!(changed, 2 + 4 * FLOOR_EASE_FRAMES, "{changed}");
+        for f in 0..20 {
             let p = out.joint_positions(f);
             assert!(
                 p[3].y.min(p[4].y) >= -CONTACT_HEIGHT - 1e-3,
@@ -629,7 +630,7 @@ mod tests {
             );
         }
         assert_eq!(out.frames[0], src.frames[0]);
-        assert_eq!(out.frames[11], src.frames[11]);
+        assert_eq!(out.frames[19], src.frames[19]);
     }
 
     #[test]
