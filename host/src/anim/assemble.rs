@@ -46,7 +46,7 @@ use super::looping::{close_loop, cycle_frames, loop_closure};
 use super::pacing::{ground_travel, pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
-use super::transition::{best_pair, blend_world, smoothstep};
+use super::transition::{best_pair, blend_world, ease_root, smoothstep, ROOT_EASE_S};
 use super::variants::{choose_variant, VariantChoice};
 use super::AnimError;
 use crate::events::ActionRecord;
@@ -59,6 +59,12 @@ pub const MAX_SPEEDUP: f32 = 3.0;
 /// Most frames an assembled animation may have (two hours at 30 fps; ≈ 360 MB of poses for a
 /// 60-joint rig): events whose times span more are refused rather than exhausting memory.
 pub const MAX_OUTPUT_FRAMES: usize = 216_000;
+
+/// Frames either side of a join within which [`assemble`] looks for the sharpest change of
+/// the root's velocity to ease.
+pub const JOIN_EASE_REACH: usize = 2;
+/// How many times [`assemble`] eases the sharpest change near each join.
+pub const JOIN_EASE_PASSES: usize = 3;
 
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,6 +135,11 @@ pub struct Assembly {
     pub ground: GroundFix,
     /// Transitions: (frame where the blend starts, frame where it ends).
     pub transitions: Vec<(usize, usize)>,
+    /// Joins, in frame order: frames where the root's motion passes from one source to
+    /// another — an action's first and last frame (before and after it, a held pose or the
+    /// next action), a blend's first and last. The root's path is eased there
+    /// ([`ease_root`]); `figurine check` judges its acceleration around them.
+    pub joins: Vec<usize>,
     /// Per transition: the motion-graph cut it follows (`--graph`), or `None` where the
     /// windowed posture distance chose it.
     pub graph_cuts: Vec<Option<crate::graph::effort::ClipCut>>,
@@ -514,6 +525,34 @@ pub fn assemble_guided(
         frames.push(pose);
         contact_frames.push(contact);
     }
+    // The root's path is C1 across every join: where a held pose meets a moving clip, or a
+    // blend hands over from one action's root to the next, its velocity changes over
+    // ROOT_EASE_S rather than in one frame.
+    let mut joins: Vec<usize> = placed
+        .iter()
+        .flat_map(|p| [p.f0, p.f1()])
+        .chain(cuts.iter().flat_map(|&(i, j)| [i, j]))
+        .filter(|&f| f <= total)
+        .collect();
+    joins.sort_unstable();
+    joins.dedup();
+    let ease = ((ROOT_EASE_S * fps).round() as usize).max(1);
+    for &k in &joins {
+        // The step may land a frame or two off the join (a clip whose root stops just before
+        // its last frame): the sharpest nearby is eased, a few times over.
+        for _ in 0..JOIN_EASE_PASSES {
+            let root = |f: usize| frames[f].translations[0];
+            let sharpest = (k.saturating_sub(JOIN_EASE_REACH).max(1)
+                ..=(k + JOIN_EASE_REACH).min(frames.len().saturating_sub(2)))
+                .max_by(|&a, &b| {
+                    let acc = |f: usize| (root(f + 1) - 2.0 * root(f) + root(f - 1)).length();
+                    acc(a).total_cmp(&acc(b))
+                });
+            if let Some(m) = sharpest {
+                ease_root(&mut frames, m, ease);
+            }
+        }
+    }
     let mut clip = Clip {
         name: "figurine".into(),
         skeleton,
@@ -537,6 +576,7 @@ pub fn assemble_guided(
         contacts,
         ground,
         transitions: cuts,
+        joins,
         graph_cuts,
         t_origin: t_shift,
     })

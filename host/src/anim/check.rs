@@ -12,6 +12,7 @@
 //! | knee bent backwards | the thigh–shin bend about the hips' right axis (a knee folds the shin back, about their left): max | ° |
 //! | elbow bent backwards | in the upper arm's frame, the bend about the opposite of the axis the elbow folds about when well bent over the clip: max | ° |
 //! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
+//! | pops at joins | an assembled animation's root acceleration within [`JOIN_WINDOW_S`] of a join (where one action, or a held pose, hands over to the next; [`check_assembly`]): max | m/s² |
 //!
 //! Lengths are read in metres; a file whose body is over [`crate::motion::CENTIMETRE_HEIGHT`]
 //! units tall is read in centimetres. The ground is the plane y = 0 (the project's
@@ -38,6 +39,11 @@ pub const NEAR_GROUND_M: f32 = 0.10;
 pub const SKATE_M_S: f32 = 0.10;
 /// Percentile of the feet's lowest height taken as the ground by [`Ground::Auto`].
 pub const AUTO_GROUND_PERCENTILE: f32 = 0.05;
+
+/// Seconds either side of a join within which [`check_assembly`] judges the root's
+/// acceleration: two frames at 30 fps, where a pop (a jump of the root's velocity from one
+/// frame to the next) shows; the actions' own motion further off is their own.
+pub const JOIN_WINDOW_S: f32 = 0.07;
 
 pub use super::envelope;
 
@@ -85,6 +91,9 @@ pub struct Plausibility {
     pub root_accel_p95: f32,
     /// Largest root acceleration, m/s².
     pub root_accel_max: f32,
+    /// Largest root acceleration within [`JOIN_WINDOW_S`] of a join, m/s² (assembled
+    /// animations, [`check_assembly`]; `None` for a file, whose joins are not known).
+    pub root_accel_joins_max: Option<f32>,
 }
 
 impl Plausibility {
@@ -104,6 +113,11 @@ impl Plausibility {
                 "elbow backwards",
             ),
             (self.root_speed_max > e::ROOT_SPEED_M_S, "root speed"),
+            (
+                self.root_accel_joins_max
+                    .is_some_and(|a| a > e::ROOT_ACCEL_JOIN_M_S2),
+                "pops at joins",
+            ),
         ]
         .into_iter()
         .filter_map(|(out, what)| out.then_some(what))
@@ -178,6 +192,27 @@ fn elbow_backwards(arm: &[(Vec3, Vec3)]) -> f32 {
         return 0.0;
     };
     max_of(arm.iter().map(|&(u, d)| bent_backwards(u, d, axis)))
+}
+
+/// Measures an assembled animation ([`check_clip`] in metres on the ground y = 0), and its
+/// root's acceleration around its joins ([`Plausibility::root_accel_joins_max`]).
+pub fn check_assembly(asm: &super::assemble::Assembly, name: &str) -> Result<Plausibility> {
+    let mut r = check_clip(&asm.clip, Ground::At(0.0), name)?;
+    r.root_accel_joins_max = Some(accel_near(&asm.clip, &asm.joins, JOIN_WINDOW_S));
+    Ok(r)
+}
+
+/// The largest acceleration (m/s², lengths in metres) of `clip`'s root within `window`
+/// seconds of any of the frames `joins` (0 without joins).
+pub fn accel_near(clip: &Clip, joins: &[usize], window: f32) -> f32 {
+    let dt = clip.frame_time.max(1e-6);
+    let w = (window / dt).round() as usize;
+    let root = clip.root_path();
+    max_of(joins.iter().flat_map(|&k| {
+        let root = &root;
+        (k.saturating_sub(w).max(1)..=(k + w).min(root.len().saturating_sub(2)))
+            .map(move |f| (root[f + 1] - 2.0 * root[f] + root[f - 1]).length() / (dt * dt))
+    }))
 }
 
 /// Measures `clip` (its lengths in the file's unit; `name` names it in errors).
@@ -334,6 +369,7 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
         root_speed_max: max_of(speed.iter().copied()),
         root_accel_p95: quantile(&accel, 0.95),
         root_accel_max: max_of(accel.iter().copied()),
+        root_accel_joins_max: None,
     })
 }
 
@@ -377,10 +413,7 @@ pub fn check_defaults(seed: u64) -> Result<Vec<Plausibility>> {
 fn check_animations(anims: &[super::defaults::DefaultAnimation]) -> Result<Vec<Plausibility>> {
     anims
         .iter()
-        .map(|a| {
-            let label = format!("{} {}", a.action, a.effort);
-            check_clip(&a.assembly.clip, Ground::At(0.0), &label)
-        })
+        .map(|a| check_assembly(&a.assembly, &format!("{} {}", a.action, a.effort)))
         .collect()
 }
 
@@ -457,12 +490,14 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
     println!(
         "within the real-mocap envelope (penetration ≤ {} mm, airborne ≤ {} s, contact-foot \
-         speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s): {within} of {}",
+         speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s, ≤ {} m/s² at joins): \
+         {within} of {}",
         envelope::PENETRATION_MM,
         envelope::AIRBORNE_S,
         envelope::SKATE_CM_S,
         envelope::BENT_BACKWARDS_DEG,
         envelope::ROOT_SPEED_M_S,
+        envelope::ROOT_ACCEL_JOIN_M_S2,
         rows.len()
     );
     let mut counts: std::collections::BTreeMap<&str, usize> = Default::default();
@@ -481,7 +516,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
 /// Prints the figures of `rows` as a table, one clip a line.
 pub fn print_table(rows: &[Plausibility]) {
     println!(
-        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13}",
+        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13} {:>10}",
         "clip",
         "s",
         "penetr. mm",
@@ -491,12 +526,13 @@ pub fn print_table(rows: &[Plausibility]) {
         "knee°",
         "elbow°",
         "root m/s",
-        "root m/s²"
+        "root m/s²",
+        "joins m/s²"
     );
     // (The measures beyond the envelope follow each row.)
     for r in rows {
         println!(
-            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0}",
+            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0} {:>10}",
             r.name.chars().take(28).collect::<String>(),
             r.seconds,
             r.penetration_mean_mm,
@@ -512,6 +548,8 @@ pub fn print_table(rows: &[Plausibility]) {
             r.root_speed_max,
             r.root_accel_p95,
             r.root_accel_max,
+            r.root_accel_joins_max
+                .map_or_else(|| "-".to_string(), |a| format!("{a:.0}")),
         );
         let beyond = r.beyond();
         if !beyond.is_empty() {
@@ -620,6 +658,26 @@ mod tests {
             p.rotations[0] = Quat::from_rotation_x(0.25 * std::f32::consts::PI)
         }));
         assert!((r.tilt_max_deg - 45.0).abs() < 0.1, "{r:?}");
+    }
+
+    #[test]
+    fn a_pop_is_measured_at_its_join_only() {
+        // Standing for half a second, then gliding at 0.6 m/s: 18 m/s² at frame 15.
+        let clip = figure(30, |f, p| {
+            p.translations[0].z += 0.02 * (f as f32 - 15.0).max(0.0);
+        });
+        let pop = accel_near(&clip, &[15], JOIN_WINDOW_S);
+        assert!((pop - 18.0).abs() < 0.01, "{pop}");
+        // A join elsewhere does not see it, nor does a file without joins.
+        assert_eq!(accel_near(&clip, &[2], 0.1), 0.0);
+        let r = check(&clip);
+        assert_eq!(r.root_accel_joins_max, None);
+        assert!(r.beyond().is_empty(), "{r:?}");
+        let judged = Plausibility {
+            root_accel_joins_max: Some(envelope::ROOT_ACCEL_JOIN_M_S2 + 1.0),
+            ..r
+        };
+        assert_eq!(judged.beyond(), vec!["pops at joins"]);
     }
 
     #[test]

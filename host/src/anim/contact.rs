@@ -230,8 +230,8 @@ pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
             (low < GROUND_Y + CONTACT_HEIGHT && d.is_finite()).then_some(d)
         })
         .collect();
-    let mut largest = 0.0f32;
-    for (f, pose) in out.frames.iter_mut().enumerate() {
+    let mut corrections = Vec::with_capacity(out.len());
+    for f in 0..out.len() {
         let before = grounded[..=f]
             .iter()
             .enumerate()
@@ -248,12 +248,40 @@ pub fn keep_source_contacts(src: &Clip, out: &mut Clip) -> f32 {
             (Some((_, c)), _) | (None, Some((_, c))) => c,
             (None, None) => 0.0,
         };
+        corrections.push(corr);
+    }
+    // Which foot the source stood on changes from frame to frame (a step, both feet down);
+    // where rescaling left the two at different heights, following each in turn would bounce
+    // the body by their difference at every switch. The correction is smoothed over
+    // CONTACT_SMOOTH_S either side: the body settles onto the new foot as a person shifts
+    // weight (the ground pass then lifts whatever foot would sink).
+    let half = (CONTACT_SMOOTH_S / out.frame_time.max(1e-6)).round() as usize;
+    let corrections = smooth(&smooth(&corrections, half), half);
+    let mut largest = 0.0f32;
+    for (pose, corr) in out.frames.iter_mut().zip(corrections) {
         if let Some(t) = pose.translations.first_mut() {
             t.y += corr;
         }
         largest = largest.max(corr.abs());
     }
     largest
+}
+
+/// Seconds either side over which [`keep_source_contacts`] smooths its height correction.
+pub const CONTACT_SMOOTH_S: f32 = 0.1;
+
+/// The mean of `xs` over `half` samples either side (the ends repeated).
+fn smooth(xs: &[f32], half: usize) -> Vec<f32> {
+    let n = xs.len() as isize;
+    let h = half as isize;
+    (0..n)
+        .map(|i| {
+            (i - h..=i + h)
+                .map(|k| xs[k.clamp(0, n - 1) as usize])
+                .sum::<f32>()
+                / (2 * h + 1) as f32
+        })
+        .collect()
 }
 
 /// Frames either side over which [`keep_feet_above_floor`] spreads a frame's restraint, so
@@ -329,11 +357,19 @@ pub fn keep_feet_above_floor(src: &Clip, out: &mut Clip) -> usize {
         })
         .collect();
     let n = share.len();
+    // The smallest share within FLOOR_EASE_FRAMES, then its mean over as many frames either
+    // side: never more than any frame near needs (each of the minima averaged saw this
+    // frame), and changing evenly rather than in steps, which would move the root's height by
+    // the step in one frame.
+    let window = |f: usize| {
+        f.saturating_sub(FLOOR_EASE_FRAMES)..=(f + FLOOR_EASE_FRAMES).min(n.saturating_sub(1))
+    };
+    let least: Vec<f32> = (0..n)
+        .map(|f| share[window(f)].iter().copied().fold(1.0f32, f32::min))
+        .collect();
     let mut changed = 0;
     for f in 0..n {
-        let lo = f.saturating_sub(FLOOR_EASE_FRAMES);
-        let hi = (f + FLOOR_EASE_FRAMES).min(n - 1);
-        let s = share[lo..=hi].iter().copied().fold(1.0f32, f32::min);
+        let s = least[window(f)].iter().sum::<f32>() / window(f).count() as f32;
         if s < 1.0 {
             out.frames[f] = blend(&src.frames[f], &out.frames[f], s);
             changed += 1;
@@ -570,22 +606,23 @@ mod tests {
 
     #[test]
     fn a_foot_rescaled_through_the_floor_is_drawn_back_and_the_rest_kept() {
-        // The source stands on the ground for 12 frames; the rescaled copy sinks 0.3 m in
-        // frames 5–6 and nowhere else.
+        // The source stands on the ground for 20 frames; the rescaled copy sinks 0.3 m in
+        // frames 9–10 and nowhere else.
         let base = leg_clip();
         let mut src = base.clone();
-        src.frames = vec![base.frames[0].clone(); 12];
+        src.frames = vec![base.frames[0].clone(); 20];
         let sink = src.joint_positions(0)[4].y.min(src.joint_positions(0)[3].y);
         for p in &mut src.frames {
             p.translations[0].y -= sink;
         }
         let mut out = src.clone();
-        for f in [5, 6] {
+        for f in [9, 10] {
             out.frames[f].translations[0].y -= 0.3;
         }
         let changed = keep_feet_above_floor(&src, &mut out);
-        assert_eq!(changed, 2 + 2 * FLOOR_EASE_FRAMES, "{changed}");
-        for f in 0..12 {
+        // The restraint eases in and out over twice FLOOR_EASE_FRAMES either side.
+        assert_eq!(changed, 2 + 4 * FLOOR_EASE_FRAMES, "{changed}");
+        for f in 0..20 {
             let p = out.joint_positions(f);
             assert!(
                 p[3].y.min(p[4].y) >= -CONTACT_HEIGHT - 1e-3,
@@ -593,7 +630,7 @@ mod tests {
             );
         }
         assert_eq!(out.frames[0], src.frames[0]);
-        assert_eq!(out.frames[11], src.frames[11]);
+        assert_eq!(out.frames[19], src.frames[19]);
     }
 
     #[test]

@@ -14,3 +14,8 @@ pub const SKATE_CM_S: f32 = 10.0;
 pub const BENT_BACKWARDS_DEG: f32 = 15.0;
 /// Root speed, m/s: the fastest real take fetched (DeepMimic's run, 4.2 m/s).
 pub const ROOT_SPEED_M_S: f32 = 4.2;
+/// Root acceleration around a join of an assembled animation, m/s²: the largest 95th
+/// percentile of the root's acceleration among the real takes within the rest of the envelope
+/// (DeepMimic's kick, 28 m/s²; people walking 4–10, dancing 13). A join may move the root as
+/// sharply as a kick does, no more.
+pub const ROOT_ACCEL_JOIN_M_S2: f32 = 28.0;
