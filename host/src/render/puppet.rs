@@ -336,8 +336,16 @@ mod tests {
         let feed = LiveFeed::new();
         let (tx, handle) = spawn_puppets(feed.clone(), clips, forward, 2);
         tx.send((1, rec("jump", 1.0), Instant::now())).unwrap();
-        std::thread::sleep(Duration::from_millis(300));
-        let snap = feed.snapshot().expect("poses were pushed");
+        // Wait for the thread to place the jump; a loaded machine (a whole test suite on two
+        // cores) may take far longer than the usual few milliseconds.
+        let deadline = Instant::now() + Duration::from_secs(20);
+        let snap = loop {
+            match feed.snapshot() {
+                Some(s) if !s.timeline.is_empty() => break s,
+                _ if Instant::now() > deadline => panic!("no poses with the jump within 20 s"),
+                _ => std::thread::sleep(Duration::from_millis(20)),
+            }
+        };
         let chars: std::collections::BTreeSet<u16> =
             snap.pose.segments.iter().map(|s| s.character).collect();
         assert_eq!(chars.len(), 2, "both characters drawn: {chars:?}");
