@@ -79,7 +79,7 @@ fn a_gesture_is_tracked_within_goals_and_reads_as_the_same_action() {
         seed: 5,
         ..Setup::default()
     };
-    let run = run_gesture(&setup, Action::Sidestep, 4, &dir, true).unwrap();
+    let run = run_gesture(&setup, Action::Sidestep, 4, &dir, true, false).unwrap();
     let all = summarize(&run.frames);
     assert!(all.frames > 30, "{} frames", all.frames);
     assert!(

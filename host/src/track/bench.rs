@@ -14,7 +14,7 @@ use clap::Args;
 use super::detect::Family;
 use super::eval::{
     compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
-    FrameError, Noise, Setup, Summary,
+    FrameError, FrameTruth, Noise, Setup, Summary,
 };
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
@@ -40,6 +40,10 @@ pub struct BenchArgs {
     /// Edge of the tag's black square, metres.
     #[arg(long, default_value_t = 0.04)]
     pub tag_size: f64,
+    /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
+    /// and tag size) instead of rendering them again; a missing one is rendered.
+    #[arg(long, requires = "keep")]
+    pub reuse: bool,
 }
 
 /// One gesture tracked.
@@ -79,6 +83,7 @@ pub fn run_gesture(
     seed: u64,
     dir: &std::path::Path,
     smooth: bool,
+    reuse: bool,
 ) -> Result<GestureRun> {
     let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
     let effort = Effort::random_state(&mut pick);
@@ -86,7 +91,22 @@ pub fn run_gesture(
     let placed = place(&doodle.log, setup.distance);
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
-    let truths = render_video(setup, &sc, &placed, &video)?;
+    let frames_path = video.with_extension("frames.csv");
+    let kept = if reuse && video.exists() {
+        read_truths(&frames_path, setup).ok()
+    } else {
+        None
+    };
+    let truths = match kept {
+        Some(t) => t,
+        None => {
+            let t = render_video(setup, &sc, &placed, &video)?;
+            if dir.join("keep").exists() {
+                write_truths(&frames_path, setup, &t)?;
+            }
+            t
+        }
+    };
     let run = track_video(setup, Family::Tag36h11, 0, &video, smooth)?;
     let frames = compare(&truths, &run.log);
     let (lib, blob) = load_library(None)?;
@@ -114,6 +134,67 @@ pub fn run_gesture(
         tracked_actions,
         latency_s: run.latency_s,
     })
+}
+
+/// Writes what each frame of a kept video showed, for `--reuse`.
+fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) -> Result<()> {
+    let mut text = format!(
+        "# tag {} m at {} m, seed {}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
+        setup.tag_size, setup.distance, setup.seed
+    );
+    for f in truths {
+        let p = &f.pose;
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            f.t,
+            p.pos[0],
+            p.pos[1],
+            p.pos[2],
+            p.quat[0],
+            p.quat[1],
+            p.quat[2],
+            p.quat[3],
+            f.speed,
+            u8::from(f.hidden),
+            p.t
+        );
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Reads what [`write_truths`] wrote; an error when it is missing, malformed or was written
+/// for another setup.
+fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut lines = text.lines();
+    let head = format!(
+        "# tag {} m at {} m, seed {}",
+        setup.tag_size, setup.distance, setup.seed
+    );
+    anyhow::ensure!(lines.next() == Some(head.as_str()), "another setup");
+    lines.next();
+    lines
+        .map(|line| {
+            let v: Vec<f64> = line
+                .split(',')
+                .map(str::parse)
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("{}: {line}", path.display()))?;
+            anyhow::ensure!(v.len() == 11, "{}: {line}", path.display());
+            Ok(FrameTruth {
+                t: v[0],
+                pose: crate::poselog::PoseSample {
+                    t: v[10],
+                    pos: [v[1], v[2], v[3]],
+                    quat: [v[4], v[5], v[6], v[7]],
+                },
+                speed: v[8],
+                hidden: v[9] != 0.0,
+            })
+        })
+        .collect()
 }
 
 fn row(out: &mut String, label: &str, s: &Summary) {
@@ -253,7 +334,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
-            let r = run_gesture(&setup, action, seed, &dir, !args.raw)?;
+            let r = run_gesture(&setup, action, seed, &dir, !args.raw, args.reuse)?;
             let s = summarize(&r.frames);
             eprintln!(
                 "{:>9} at {distance:.2} m: {} frames, {:.1} % lost, {:.1} mm, {:.2}°, truth {:?}, tracked {:?}",
