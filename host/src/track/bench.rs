@@ -14,7 +14,7 @@ use clap::Args;
 use super::detect::Family;
 use super::eval::{
     compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
-    FrameError, FrameTruth, Noise, Setup, Summary,
+    FrameError, FrameTruth, Noise, Setup, Summary, Tracking,
 };
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
@@ -40,6 +40,10 @@ pub struct BenchArgs {
     /// Edge of the tag's black square, metres.
     #[arg(long, default_value_t = 0.04)]
     pub tag_size: f64,
+    /// Search every frame whole, not near the tag's last place first (slower; for
+    /// comparing the two).
+    #[arg(long)]
+    pub whole_frames: bool,
     /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
@@ -59,6 +63,10 @@ pub struct GestureRun {
     pub truth_actions: Vec<String>,
     /// Actions it read from the tracked log.
     pub tracked_actions: Vec<String>,
+    /// Actions it read from the truth kept at only the frames where the tracker gave a
+    /// sample: what a tracker without error, but with the same gaps (the tag out of sight,
+    /// lost), would give.
+    pub gapped_actions: Vec<String>,
     /// Tracking time per frame (detection and pose), seconds.
     pub latency_s: Vec<f64>,
 }
@@ -82,7 +90,7 @@ pub fn run_gesture(
     action: Action,
     seed: u64,
     dir: &std::path::Path,
-    smooth: bool,
+    how: Tracking,
     reuse: bool,
 ) -> Result<GestureRun> {
     let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
@@ -107,7 +115,7 @@ pub fn run_gesture(
             t
         }
     };
-    let run = track_video(setup, Family::Tag36h11, 0, &video, smooth)?;
+    let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);
     let (lib, blob) = load_library(None)?;
     let effort_model = load_effort(None)?;
@@ -122,6 +130,15 @@ pub fn run_gesture(
     let truth = truth_log(&truths);
     let truth_actions = read(&truth)?;
     let tracked_actions = read(&run.log)?;
+    let gapped = crate::poselog::PoseLog {
+        samples: truth
+            .samples
+            .iter()
+            .filter(|s| run.log.samples.iter().any(|k| (k.t - s.t).abs() < 1e-6))
+            .copied()
+            .collect(),
+    };
+    let gapped_actions = read(&gapped)?;
     if dir.join("keep").exists() {
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;
@@ -132,6 +149,7 @@ pub fn run_gesture(
         frames,
         truth_actions,
         tracked_actions,
+        gapped_actions,
         latency_s: run.latency_s,
     })
 }
@@ -257,14 +275,32 @@ pub fn report(runs: &[GestureRun]) -> String {
         runs.len(),
         100.0 * same as f64 / runs.len().max(1) as f64
     );
+    let share = |n: usize| 100.0 * n as f64 / runs.len().max(1) as f64;
+    let gaps_only = runs
+        .iter()
+        .filter(|r| r.gapped_actions == r.truth_actions)
+        .count();
+    let error_only = runs
+        .iter()
+        .filter(|r| r.gapped_actions == r.tracked_actions)
+        .count();
+    let _ = writeln!(
+        out,
+        "  the gaps alone (the truth kept at only the frames the tracker gave a sample) leave it \
+         the same in {gaps_only} ({:.1} %); the tracker's error alone (tracked against that gapped \
+         truth) in {error_only} ({:.1} %)",
+        share(gaps_only),
+        share(error_only)
+    );
     for r in runs.iter().filter(|r| r.truth_actions != r.tracked_actions) {
         let _ = writeln!(
             out,
-            "  {} at {:.2} m: truth {:?}, tracked {:?}",
+            "  {} at {:.2} m: truth {:?}, tracked {:?}, truth with the gaps {:?}",
             r.action.name(),
             r.distance,
             r.truth_actions,
-            r.tracked_actions
+            r.tracked_actions,
+            r.gapped_actions
         );
     }
     let mut lat: Vec<f64> = runs.iter().flat_map(|r| r.latency_s.clone()).collect();
@@ -334,7 +370,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
-            let r = run_gesture(&setup, action, seed, &dir, !args.raw, args.reuse)?;
+            let how = Tracking {
+                smooth: !args.raw,
+                region_search: !args.whole_frames,
+            };
+            let r = run_gesture(&setup, action, seed, &dir, how, args.reuse)?;
             let s = summarize(&r.frames);
             eprintln!(
                 "{:>9} at {distance:.2} m: {} frames, {:.1} % lost, {:.1} mm, {:.2}°, truth {:?}, tracked {:?}",
@@ -354,4 +394,64 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let _ = std::fs::remove_dir_all(&dir);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(truth: &[&str], tracked: &[&str], gapped: &[&str]) -> GestureRun {
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
+        GestureRun {
+            action: Action::Walk,
+            distance: 0.5,
+            frames: Vec::new(),
+            truth_actions: names(truth),
+            tracked_actions: names(tracked),
+            gapped_actions: names(gapped),
+            latency_s: vec![0.001],
+        }
+    }
+
+    #[test]
+    fn the_report_parts_the_gaps_from_the_tracker_s_error() {
+        let runs = [
+            run(&["walk"], &["walk"], &["walk"]),
+            // Out of sight half the time: the gaps alone lose it, the tracker adds nothing.
+            run(&["spin"], &["turn"], &["turn"]),
+            // In sight throughout: the tracker's error alone.
+            run(&["kick"], &["bow"], &["kick"]),
+        ];
+        let text = report(&runs);
+        assert!(text.contains("in 1 of 3 gestures"), "{text}");
+        assert!(text.contains("leave it the same in 2 (66.7 %)"), "{text}");
+        assert!(text.contains("in 2 (66.7 %)\n"), "{text}");
+        assert!(text.contains("truth with the gaps [\"turn\"]"), "{text}");
+    }
+
+    #[test]
+    fn kept_truths_read_back_and_refuse_another_setup() {
+        let dir = std::env::temp_dir().join(format!("figurine-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("frames.csv");
+        let setup = Setup::default();
+        let truths = vec![FrameTruth {
+            t: 0.1,
+            pose: crate::poselog::PoseSample {
+                t: 3.1,
+                pos: [0.1, -0.2, -0.7],
+                quat: [1.0, 0.0, 0.0, 0.0],
+            },
+            speed: 0.25,
+            hidden: true,
+        }];
+        write_truths(&path, &setup, &truths).unwrap();
+        assert_eq!(read_truths(&path, &setup).unwrap(), truths);
+        let other = Setup {
+            distance: 1.0,
+            ..setup
+        };
+        assert!(read_truths(&path, &other).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
