@@ -14,7 +14,7 @@ use clap::Args;
 use super::detect::Family;
 use super::eval::{
     compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
-    FrameError, Noise, Setup, Summary,
+    FrameError, FrameTruth, Noise, Setup, Summary, Tracking,
 };
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
@@ -40,6 +40,14 @@ pub struct BenchArgs {
     /// Edge of the tag's black square, metres.
     #[arg(long, default_value_t = 0.04)]
     pub tag_size: f64,
+    /// Search every frame whole, not near the tag's last place first (slower; for
+    /// comparing the two).
+    #[arg(long)]
+    pub whole_frames: bool,
+    /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
+    /// and tag size) instead of rendering them again; a missing one is rendered.
+    #[arg(long, requires = "keep")]
+    pub reuse: bool,
 }
 
 /// One gesture tracked.
@@ -55,6 +63,10 @@ pub struct GestureRun {
     pub truth_actions: Vec<String>,
     /// Actions it read from the tracked log.
     pub tracked_actions: Vec<String>,
+    /// Actions it read from the truth kept at only the frames where the tracker gave a
+    /// sample: what a tracker without error, but with the same gaps (the tag out of sight,
+    /// lost), would give.
+    pub gapped_actions: Vec<String>,
     /// Tracking time per frame (detection and pose), seconds.
     pub latency_s: Vec<f64>,
 }
@@ -78,7 +90,8 @@ pub fn run_gesture(
     action: Action,
     seed: u64,
     dir: &std::path::Path,
-    smooth: bool,
+    how: Tracking,
+    reuse: bool,
 ) -> Result<GestureRun> {
     let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
     let effort = Effort::random_state(&mut pick);
@@ -86,8 +99,23 @@ pub fn run_gesture(
     let placed = place(&doodle.log, setup.distance);
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
-    let truths = render_video(setup, &sc, &placed, &video)?;
-    let run = track_video(setup, Family::Tag36h11, 0, &video, smooth)?;
+    let frames_path = video.with_extension("frames.csv");
+    let kept = if reuse && video.exists() {
+        read_truths(&frames_path, setup).ok()
+    } else {
+        None
+    };
+    let truths = match kept {
+        Some(t) => t,
+        None => {
+            let t = render_video(setup, &sc, &placed, &video)?;
+            if dir.join("keep").exists() {
+                write_truths(&frames_path, setup, &t)?;
+            }
+            t
+        }
+    };
+    let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);
     let (lib, blob) = load_library(None)?;
     let effort_model = load_effort(None)?;
@@ -102,6 +130,15 @@ pub fn run_gesture(
     let truth = truth_log(&truths);
     let truth_actions = read(&truth)?;
     let tracked_actions = read(&run.log)?;
+    let gapped = crate::poselog::PoseLog {
+        samples: truth
+            .samples
+            .iter()
+            .filter(|s| run.log.samples.iter().any(|k| (k.t - s.t).abs() < 1e-6))
+            .copied()
+            .collect(),
+    };
+    let gapped_actions = read(&gapped)?;
     if dir.join("keep").exists() {
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;
@@ -112,8 +149,70 @@ pub fn run_gesture(
         frames,
         truth_actions,
         tracked_actions,
+        gapped_actions,
         latency_s: run.latency_s,
     })
+}
+
+/// Writes what each frame of a kept video showed, for `--reuse`.
+fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) -> Result<()> {
+    let mut text = format!(
+        "# tag {} m at {} m, seed {}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
+        setup.tag_size, setup.distance, setup.seed
+    );
+    for f in truths {
+        let p = &f.pose;
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            f.t,
+            p.pos[0],
+            p.pos[1],
+            p.pos[2],
+            p.quat[0],
+            p.quat[1],
+            p.quat[2],
+            p.quat[3],
+            f.speed,
+            u8::from(f.hidden),
+            p.t
+        );
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Reads what [`write_truths`] wrote; an error when it is missing, malformed or was written
+/// for another setup.
+fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut lines = text.lines();
+    let head = format!(
+        "# tag {} m at {} m, seed {}",
+        setup.tag_size, setup.distance, setup.seed
+    );
+    anyhow::ensure!(lines.next() == Some(head.as_str()), "another setup");
+    lines.next();
+    lines
+        .map(|line| {
+            let v: Vec<f64> = line
+                .split(',')
+                .map(str::parse)
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("{}: {line}", path.display()))?;
+            anyhow::ensure!(v.len() == 11, "{}: {line}", path.display());
+            Ok(FrameTruth {
+                t: v[0],
+                pose: crate::poselog::PoseSample {
+                    t: v[10],
+                    pos: [v[1], v[2], v[3]],
+                    quat: [v[4], v[5], v[6], v[7]],
+                },
+                speed: v[8],
+                hidden: v[9] != 0.0,
+            })
+        })
+        .collect()
 }
 
 fn row(out: &mut String, label: &str, s: &Summary) {
@@ -176,14 +275,32 @@ pub fn report(runs: &[GestureRun]) -> String {
         runs.len(),
         100.0 * same as f64 / runs.len().max(1) as f64
     );
+    let share = |n: usize| 100.0 * n as f64 / runs.len().max(1) as f64;
+    let gaps_only = runs
+        .iter()
+        .filter(|r| r.gapped_actions == r.truth_actions)
+        .count();
+    let error_only = runs
+        .iter()
+        .filter(|r| r.gapped_actions == r.tracked_actions)
+        .count();
+    let _ = writeln!(
+        out,
+        "  the gaps alone (the truth kept at only the frames the tracker gave a sample) leave it \
+         the same in {gaps_only} ({:.1} %); the tracker's error alone (tracked against that gapped \
+         truth) in {error_only} ({:.1} %)",
+        share(gaps_only),
+        share(error_only)
+    );
     for r in runs.iter().filter(|r| r.truth_actions != r.tracked_actions) {
         let _ = writeln!(
             out,
-            "  {} at {:.2} m: truth {:?}, tracked {:?}",
+            "  {} at {:.2} m: truth {:?}, tracked {:?}, truth with the gaps {:?}",
             r.action.name(),
             r.distance,
             r.truth_actions,
-            r.tracked_actions
+            r.tracked_actions,
+            r.gapped_actions
         );
     }
     let mut lat: Vec<f64> = runs.iter().flat_map(|r| r.latency_s.clone()).collect();
@@ -253,7 +370,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
-            let r = run_gesture(&setup, action, seed, &dir, !args.raw)?;
+            let how = Tracking {
+                smooth: !args.raw,
+                region_search: !args.whole_frames,
+            };
+            let r = run_gesture(&setup, action, seed, &dir, how, args.reuse)?;
             let s = summarize(&r.frames);
             eprintln!(
                 "{:>9} at {distance:.2} m: {} frames, {:.1} % lost, {:.1} mm, {:.2}°, truth {:?}, tracked {:?}",
@@ -273,4 +394,64 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let _ = std::fs::remove_dir_all(&dir);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(truth: &[&str], tracked: &[&str], gapped: &[&str]) -> GestureRun {
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
+        GestureRun {
+            action: Action::Walk,
+            distance: 0.5,
+            frames: Vec::new(),
+            truth_actions: names(truth),
+            tracked_actions: names(tracked),
+            gapped_actions: names(gapped),
+            latency_s: vec![0.001],
+        }
+    }
+
+    #[test]
+    fn the_report_parts_the_gaps_from_the_tracker_s_error() {
+        let runs = [
+            run(&["walk"], &["walk"], &["walk"]),
+            // Out of sight half the time: the gaps alone lose it, the tracker adds nothing.
+            run(&["spin"], &["turn"], &["turn"]),
+            // In sight throughout: the tracker's error alone.
+            run(&["kick"], &["bow"], &["kick"]),
+        ];
+        let text = report(&runs);
+        assert!(text.contains("in 1 of 3 gestures"), "{text}");
+        assert!(text.contains("leave it the same in 2 (66.7 %)"), "{text}");
+        assert!(text.contains("in 2 (66.7 %)\n"), "{text}");
+        assert!(text.contains("truth with the gaps [\"turn\"]"), "{text}");
+    }
+
+    #[test]
+    fn kept_truths_read_back_and_refuse_another_setup() {
+        let dir = std::env::temp_dir().join(format!("figurine-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("frames.csv");
+        let setup = Setup::default();
+        let truths = vec![FrameTruth {
+            t: 0.1,
+            pose: crate::poselog::PoseSample {
+                t: 3.1,
+                pos: [0.1, -0.2, -0.7],
+                quat: [1.0, 0.0, 0.0, 0.0],
+            },
+            speed: 0.25,
+            hidden: true,
+        }];
+        write_truths(&path, &setup, &truths).unwrap();
+        assert_eq!(read_truths(&path, &setup).unwrap(), truths);
+        let other = Setup {
+            distance: 1.0,
+            ..setup
+        };
+        assert!(read_truths(&path, &other).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -74,8 +74,8 @@ pub struct RunArgs {
     /// Camera frames per second.
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
-    /// Detector threads.
-    #[arg(long, default_value_t = 1)]
+    /// Detector threads for a whole frame's search (a region near the tag uses one).
+    #[arg(long, default_value_t = 2)]
     pub threads: u32,
     /// Write the orientation as measured, without the adaptive smoothing that keeps a still
     /// figurine from jittering by a degree or two.

@@ -193,18 +193,38 @@ pub fn render_video(
     Ok(truths)
 }
 
+/// The tracker's switches a test run sets (those of `figurine track`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tracking {
+    /// Smooth the orientation ([`super::smooth`]; `figurine track --raw` turns it off).
+    pub smooth: bool,
+    /// Search near the tag's last place first ([`Tracker::with_region_search`]).
+    pub region_search: bool,
+}
+
+impl Default for Tracking {
+    fn default() -> Self {
+        Self {
+            smooth: true,
+            region_search: true,
+        }
+    }
+}
+
 /// Tracks a video file with the setup's camera (its field of view known exactly).
 pub fn track_video(
     setup: &Setup,
     family: Family,
     id: u32,
     path: &Path,
-    smooth: bool,
+    how: Tracking,
 ) -> Result<super::tracker::TrackRun, TrackError> {
     let mut reader = FrameReader::open(Source::File(path.to_path_buf()))?;
     let k = intrinsics_from_fov(reader.width(), reader.height(), setup.fov_deg);
     let detector = Detector::new(family, DetectorSettings::default())?;
-    let mut tracker = Tracker::new(detector, id, setup.tag_size, k).with_smoothing(smooth);
+    let mut tracker = Tracker::new(detector, id, setup.tag_size, k)
+        .with_smoothing(how.smooth)
+        .with_region_search(how.region_search);
     track_reader(&mut reader, &mut tracker, |_| Ok(()))
 }
 

@@ -1,10 +1,11 @@
 //! `figurine track`: a webcam and a printed AprilTag as a 6-DoF tracker anyone has.
 //!
 //! Frames come from a video file or a V4L2 camera through ffmpeg ([`video`]); libapriltag
-//! finds the tag and its corners ([`detect`]); [`pnp`] solves its pose from them (homography,
-//! then Levenberg–Marquardt on the four corners); [`pose`] turns that into the pose log's
-//! frames; [`tracker`] keeps one tag id and writes a sample per frame where it was seen — a
-//! lost tag gives no sample, never a made-up pose. [`render`] draws test videos of the tag on
+//! finds the tag and its corners ([`detect`]), near its last place first and in the whole
+//! frame when it is not there; [`pnp`] solves its pose from them (homography, then
+//! Levenberg–Marquardt on the four corners); [`pose`] turns that into the pose log's frames;
+//! [`tracker`] keeps one tag id and writes a sample per frame where it was seen — a lost tag
+//! gives no sample, never a made-up pose. [`render`] draws test videos of the tag on
 //! a moving figurine and [`eval`] compares what was tracked with the truth.
 
 pub mod bench;
