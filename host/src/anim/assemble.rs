@@ -66,6 +66,13 @@ pub const JOIN_EASE_REACH: usize = 2;
 /// How many times [`assemble`] eases the sharpest change near each join.
 pub const JOIN_EASE_PASSES: usize = 3;
 
+/// Share of [`HUMAN_ROOT_SPEED_M_S`] the root may reach where [`assemble`] eases a join
+/// ([`ease_root`]'s `top`): more than the actions are paced to ([`PACE_HEADROOM`]), since a
+/// ramp from one paced motion into another passes a little above either, but short of the
+/// limit itself, since the ground pass after it raises the root by a millimetre here and there
+/// (a strong jump eased to the limit landed at 4.2004 m/s).
+pub const JOIN_EASE_HEADROOM: f32 = 0.99;
+
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AssembleOptions {
@@ -537,6 +544,9 @@ pub fn assemble_guided(
     joins.sort_unstable();
     joins.dedup();
     let ease = ((ROOT_EASE_S * fps).round() as usize).max(1);
+    // Nor does the easing make the root outrun a person: it may use most of the headroom the
+    // actions were paced with (PACE_HEADROOM), not all (the ground pass comes after).
+    let top = HUMAN_ROOT_SPEED_M_S * JOIN_EASE_HEADROOM / fps;
     for &k in &joins {
         // The step may land a frame or two off the join (a clip whose root stops just before
         // its last frame): the sharpest nearby is eased, a few times over.
@@ -549,7 +559,7 @@ pub fn assemble_guided(
                     acc(a).total_cmp(&acc(b))
                 });
             if let Some(m) = sharpest {
-                ease_root(&mut frames, m, ease);
+                ease_root(&mut frames, m, ease, top);
             }
         }
     }

@@ -112,8 +112,10 @@ pub const ROOT_EASE_S: f32 = 0.18;
 /// `half` frames after the join (the ramp gains before the join what it loses after). What
 /// stood still and runs at 4 m/s in the next frame now sets off over `2·half` frames, and
 /// moves at most `|Δv|·half/4` away from its path meanwhile (the feet are re-planted
-/// afterwards).
-pub fn ease_root(frames: &mut [Pose], join: usize, half: usize) {
+/// afterwards). No frame of the window is left faster than `top` (distance per frame) or the
+/// fastest the root already moved in it: where the full ramp would be, only the share of the
+/// step that keeps within is eased.
+pub fn ease_root(frames: &mut [Pose], join: usize, half: usize, top: f32) {
     let n = frames.len();
     if half == 0 || join < half || join + half >= n {
         return;
@@ -128,17 +130,48 @@ pub fn ease_root(frames: &mut [Pose], join: usize, half: usize) {
     // Velocity per frame: v(f) = root(f + 1) − root(f).
     let step = (root(join + 1) - root(join)) - (root(join) - root(join - 1));
     let span = 2 * half;
-    let mut shift = Vec3::ZERO;
-    for m in 0..span {
-        // Frame join − half + m moves with v + step·(ramp − [after the join]).
+    // Frame join − half + m moves with v + step·(ramp − [after the join]).
+    let change = |m: usize| {
         let ramp = (m as f32 + 0.5) / span as f32;
         let after = if m >= half { 1.0 } else { 0.0 };
-        shift += step * (ramp - after);
+        step * (ramp - after)
+    };
+    // The ramp redistributes a change of velocity, but where the root's own velocity varies
+    // within the window (a jump's landing, its squat before it) a full ramp adds the step to
+    // speeds already high: the root would outrun a person. The step is eased as far as keeps
+    // every frame within `top` (or the fastest the root already moved there): all of it, in
+    // the common case.
+    let own: Vec<Vec3> = (0..span)
+        .map(|m| root(join - half + m + 1) - root(join - half + m))
+        .collect();
+    let fastest = own.iter().map(|v| v.length()).fold(top, f32::max);
+    let within =
+        |s: f32| (0..span).all(|m| (own[m] + change(m) * s).length() <= fastest * (1.0 + 1e-4));
+    let share = if within(1.0) {
+        1.0
+    } else {
+        let (mut ok, mut bad) = (0.0f32, 1.0f32);
+        for _ in 0..EASE_BISECTIONS {
+            let mid = 0.5 * (ok + bad);
+            if within(mid) {
+                ok = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        ok
+    };
+    let mut shift = Vec3::ZERO;
+    for m in 0..span {
+        shift += change(m) * share;
         if let Some(t) = frames[join - half + m + 1].translations.first_mut() {
             *t += shift;
         }
     }
 }
+
+/// Bisection steps of [`ease_root`]'s share of a step that keeps the root within its speed.
+const EASE_BISECTIONS: usize = 12;
 
 /// Blends two world-placed poses (root translation and rotation are world values).
 pub fn blend_world(a: &Pose, b: &Pose, w: f32) -> Pose {
@@ -201,7 +234,7 @@ mod tests {
         let before = accel(&track).into_iter().fold(0.0f32, f32::max);
         assert!((before - 0.1).abs() < 1e-5, "{before}");
         let mut eased = track.clone();
-        ease_root(&mut eased, 20, 5);
+        ease_root(&mut eased, 20, 5, 0.1);
         let after = accel(&eased).into_iter().fold(0.0f32, f32::max);
         // The 0.1 step is spread over 10 frames.
         assert!(after <= 0.1 / 10.0 + 1e-4, "{after}");
@@ -225,7 +258,7 @@ mod tests {
         for (f, p) in bobbing.iter_mut().enumerate() {
             p.translations[0].y += bob(f);
         }
-        ease_root(&mut bobbing, 20, 5);
+        ease_root(&mut bobbing, 20, 5, 0.1);
         for (f, (a, b)) in bobbing.iter().zip(&eased).enumerate() {
             let d = a.translations[0] - b.translations[0];
             assert!(
@@ -233,6 +266,46 @@ mod tests {
                 "frame {f}: {d}"
             );
         }
+    }
+
+    /// The root's fastest speed (per frame) over `frames`.
+    fn fastest(frames: &[Pose]) -> f32 {
+        frames
+            .windows(2)
+            .map(|w| (w[1].translations[0] - w[0].translations[0]).length())
+            .fold(0.0f32, f32::max)
+    }
+
+    #[test]
+    fn easing_never_makes_the_root_outrun_its_top_speed() {
+        // Rising at 0.1 per frame, a frame's dwell at frame 20, rising again: the stop's step
+        // (−0.1) ramped over 10 frames gives back its +0.1 to the frames after the dwell, which
+        // already rise at 0.1.
+        let pose = |y: f32| Pose {
+            rotations: vec![Quat::IDENTITY],
+            translations: vec![Vec3::new(0.0, y, 0.0)],
+        };
+        let track: Vec<Pose> = (0..50)
+            .map(|f| {
+                let f = f as f32;
+                pose(0.1 * f.min(20.0) + 0.1 * (f - 21.0).max(0.0))
+            })
+            .collect();
+        assert!((fastest(&track) - 0.1).abs() < 1e-5);
+        // Unbounded, the ramp moves the root faster than 0.12 per frame …
+        let mut free = track.clone();
+        ease_root(&mut free, 20, 5, f32::INFINITY);
+        assert!(fastest(&free) > 0.13, "{}", fastest(&free));
+        // … bounded by 0.12, it eases as much of the step as keeps within it.
+        let mut held = track.clone();
+        ease_root(&mut held, 20, 5, 0.12);
+        assert!(fastest(&held) <= 0.12 + 1e-4, "{}", fastest(&held));
+        let moved = held
+            .iter()
+            .zip(&track)
+            .map(|(a, b)| (a.translations[0] - b.translations[0]).length())
+            .fold(0.0f32, f32::max);
+        assert!(moved > 0.01, "{moved}");
     }
 
     #[test]
