@@ -346,7 +346,7 @@ mod tests {
         assert_eq!(t.seq, 1);
     }
 
-    /// The tick positions' spread about their mean for alternating ±1 mm jitter at `rate` Hz.
+    /// The tick positions' spread about their mean for pseudo-random ±1 mm jitter at `rate` Hz.
     fn jitter_at_ticks(rate: u64) -> f32 {
         let mut i = Intake::new();
         let period = 1_000_000 / rate;
