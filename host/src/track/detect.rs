@@ -488,20 +488,12 @@ mod tests {
 
     #[test]
     fn a_region_search_finds_the_tag_at_the_frame_s_coordinates() {
-        use crate::track::pose::intrinsics_from_fov;
-        use crate::track::render::{Faults, Scene};
-        let s = Scene {
-            width: 640,
-            height: 480,
-            intrinsics: intrinsics_from_fov(640, 480, 60.0),
-            tag: tag_pattern(Family::Tag36h11, 0).unwrap(),
-            tag_size: 0.04,
-            faults: Faults {
-                occlusion_every_s: 0.0,
-                ..Faults::default()
-            },
-            seed: 1,
+        use crate::track::render::{tests::test_scene, Faults};
+        let faults = Faults {
+            occlusion_every_s: 0.0,
+            ..Faults::default()
         };
+        let s = test_scene(faults, 1);
         let pose = crate::poselog::PoseSample {
             t: 0.0,
             pos: [0.1, 0.05, -0.6],

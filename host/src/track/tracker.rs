@@ -238,23 +238,15 @@ pub fn track_reader(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::track::detect::{tag_pattern, DetectorSettings, Family};
-    use crate::track::pose::intrinsics_from_fov;
-    use crate::track::render::{Faults, Scene};
+    use crate::track::detect::{DetectorSettings, Family};
+    use crate::track::render::{tests::test_scene, Faults, Scene};
 
     fn scene() -> Scene {
-        Scene {
-            width: 640,
-            height: 480,
-            intrinsics: intrinsics_from_fov(640, 480, 60.0),
-            tag: tag_pattern(Family::Tag36h11, 0).unwrap(),
-            tag_size: 0.04,
-            faults: Faults {
-                occlusion_every_s: 0.0,
-                ..Faults::default()
-            },
-            seed: 4,
-        }
+        let faults = Faults {
+            occlusion_every_s: 0.0,
+            ..Faults::default()
+        };
+        test_scene(faults, 4)
     }
 
     fn tracker(scene: &Scene) -> Tracker {
