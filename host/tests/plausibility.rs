@@ -13,6 +13,7 @@ use figurine_host::anim::cli::label_events;
 use figurine_host::anim::defaults::default_animations;
 use figurine_host::anim::library::ClipLibrary;
 use figurine_host::data::data_file;
+use figurine_host::recognize::simulate::effort_words;
 use figurine_host::synth::{sequence, Action, Knobs};
 
 #[test]
@@ -271,11 +272,7 @@ fn generated_sequences_stay_within_the_envelope_their_source_takes_keep() {
         .unwrap();
         let played: Vec<String> = events
             .iter()
-            .map(|e| {
-                let time = if e.time > 0.0 { "sudden" } else { "sustained" };
-                let weight = if e.weight > 0.0 { "strong" } else { "light" };
-                format!("{} {time}-{weight}", e.action)
-            })
+            .map(|e| format!("{} {}", e.action, effort_words(e.time, e.weight)))
             .collect();
         let mut exempt = played_beyond(&asm, &inherited);
         exempt.insert("pops at joins");
