@@ -6,18 +6,24 @@
 //! table; `… -- FRAMES` runs one size. Needs the data of `cargo xtask setup` (or
 //! FIGURINE_DATA_DIR).
 //!
-//! `… -- engine [FRAMES]` (default 54,000) compares `graph build` with the same job planned,
-//! run as a Slurm job array on a single-node cluster started for it (see
-//! `tests/support/slurm.rs`; needs root and the `slurm-wlm` and `munge` packages) and merged;
-//! it prints the engine's overhead, time and memory per tile, merge time and memory, the
-//! feature store's size, and a scale model for 4 M frames. It needs the release `figurine`
-//! binary beside the examples folder (`cargo build --release -p figurine-host --bin figurine`).
+//! `… -- engine` compares `graph build` with the same job planned, run as a Slurm job array on
+//! a single-node cluster started for it (see `tests/support/slurm.rs`; needs root and the
+//! `slurm-wlm` and `munge` packages) and merged: 54k frames in 10, 3 and 1 tiles, three runs
+//! (medians printed), then 108k frames once. It prints the engine's overhead, its stages from
+//! plan to graph, time and memory per tile, merge time and memory, the feature store's size,
+//! and a scale model for 4 M frames. `… -- engine FRAMES RUNS BAND…` runs one library size
+//! with the given bands (frames) RUNS times. It needs the release `figurine` binary beside the
+//! examples folder (`cargo build --release -p figurine-host --bin figurine`).
 
 use std::process::Command;
 use std::time::Instant;
 
 #[path = "support/graph_engine.rs"]
 mod engine;
+#[path = "support/engine_figures.rs"]
+mod figures;
+#[path = "support/slurm_log.rs"]
+mod slurm_log;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -96,16 +102,30 @@ fn main() -> anyhow::Result<()> {
             .map(|f| require_data_file("bvh", f))
             .collect::<anyhow::Result<Vec<_>>>()?;
         let base = load_clips(&paths, &Default::default())?;
-        // 54k frames cut into 10, 3 and 1 tiles (the default band), then a library twice as
-        // large in 3 tiles of the default band, long enough for Slurm's latency to fade.
+        if let [frames, runs, bands @ ..] = &args[1..] {
+            let bands = bands
+                .iter()
+                .map(|b| b.parse())
+                .collect::<Result<Vec<usize>, _>>()?;
+            anyhow::ensure!(!bands.is_empty(), "usage: engine [FRAMES RUNS BAND…]");
+            return engine::run(
+                &library(&base, frames.parse()?),
+                &bands,
+                runs.parse()?,
+                false,
+            );
+        }
+        // 54k frames cut into 10, 3 and 1 tiles (the default band), three times over for
+        // medians, then a library twice as large in 3 tiles of the default band.
         println!("54,000 frames:");
         engine::run(
             &library(&base, 54_000),
             &[16_384, 27_136, DEFAULT_BAND],
+            3,
             true,
         )?;
         println!("\n108,000 frames:");
-        return engine::run(&library(&base, 108_000), &[DEFAULT_BAND], false);
+        return engine::run(&library(&base, 108_000), &[DEFAULT_BAND], 1, false);
     }
     if let Some(arg) = args.first() {
         return one(arg.parse()?);

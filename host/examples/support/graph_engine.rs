@@ -1,21 +1,28 @@
 //! `graph_bench engine`: the same library built by `graph build` and by a Slurm job array of
 //! `graph tile` tasks with a dependent `graph merge`, on a single-node cluster started here.
 //!
-//! Two overheads are printed: wall time (plan to merged graph, against the build's) and CPU
-//! time (plan + every tile + merge, against the build's). On a machine shared with other work
-//! wall time also measures the neighbours; CPU time measures what the split itself costs, and
-//! the gap (wall time neither plan, tile nor merge, per task) is what Slurm adds. The scale
-//! model uses CPU time per window pair divided by the cores of a task.
+//! Two overheads are printed: wall time (plan to merged graph file, against the build's) and
+//! CPU time (plan + every tile + merge, against the build's). On a machine shared with other
+//! work wall time also measures the neighbours; CPU time measures what the split itself costs,
+//! and the gap (wall time neither plan, tile nor merge, per task) is what Slurm adds. Each run
+//! also prints its stages from plan to graph: the plan's, each tile's and the merge's own
+//! timings (from their log lines) and Slurm's (from slurmctld's log: submission, allocation
+//! and completion of every task), so that where the time goes is measured, not guessed. With
+//! several runs, the medians follow. The scale model uses CPU time per window pair divided by
+//! the cores of a task.
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
+use figurine_host::graph::build::BuildStats;
 use figurine_host::graph::plan::plan_job;
 use figurine_host::graph::slurm::write_scripts;
 use figurine_host::graph::store::BYTES_PER_FRAME;
 use figurine_host::graph::{build_graph, BuildParams};
 use figurine_host::graph::{cpu_seconds, peak_memory_mib, GraphClip, Variant};
 
+use crate::figures::{after, tile_log, EngineRun, Row};
+use crate::slurm_log::timeline;
 use crate::support::slurm::Cluster;
 
 /// Frames of the library the scale model is for (about 40 h at 30 fps, AMASS-size).
@@ -25,66 +32,32 @@ const MODEL_BAND: f64 = 131_072.0;
 /// Machine counts of the scale model.
 const MODEL_MACHINES: [f64; 4] = [1.0, 10.0, 50.0, 200.0];
 
-/// Figures of one tile task, from its log line.
-#[derive(Debug, Default, Clone, Copy)]
-struct TileLog {
-    pairs: f64,
-    read_s: f64,
-    search_s: f64,
-    cpu_s: f64,
-    peak_mib: f64,
-}
-
-/// The number after `key` in `text` (e.g. `"read "` → 0.12 in "read 0.12 s").
-fn after(text: &str, key: &str) -> Option<f64> {
-    let rest = &text[text.find(key)? + key.len()..];
-    rest.split(|c: char| !(c.is_ascii_digit() || c == '.'))
-        .next()?
-        .parse()
-        .ok()
-}
-
-fn tile_log(job: &Path, i: usize) -> Result<TileLog> {
-    let path = job.join("logs").join(format!("tile-{i}.out"));
-    let t = std::fs::read_to_string(&path).with_context(|| path.display().to_string())?;
-    let pairs = t
-        .split(" window pairs")
-        .next()
-        .and_then(|s| s.rsplit(' ').next())
-        .and_then(|n| n.parse().ok());
-    let cpu = after(&t, "cpu ");
-    match (
-        pairs,
-        after(&t, "read "),
-        after(&t, "search "),
-        cpu,
-        after(&t, "peak "),
-    ) {
-        (Some(pairs), Some(read_s), Some(search_s), Some(cpu_s), Some(peak_mib)) => Ok(TileLog {
-            pairs,
-            read_s,
-            search_s,
-            cpu_s,
-            peak_mib,
-        }),
-        _ => bail!("{}: no figures in `{t}`", path.display()),
+/// Waits for the merged graph `graph` of merge job `merge_id`: a file test every 5 ms (what a
+/// user waits for, and no load on the node), Slurm asked once a second whether the job ended
+/// without it. An `scontrol` call every 0.1 s, as before, took ≈ 8 ms of CPU each from the
+/// tasks it timed.
+fn wait_for_graph(cluster: &Cluster, merge_id: &str, graph: &Path, job: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let mut asked = Instant::now();
+    while !graph.is_file() {
+        if t0.elapsed() > Duration::from_secs(1800) {
+            bail!("no graph after 30 minutes\n{}", cluster.log_tail());
+        }
+        if asked.elapsed() > Duration::from_secs(1) {
+            asked = Instant::now();
+            if let Some(state) = cluster.ended_state(merge_id) {
+                if !graph.is_file() {
+                    let log = std::fs::read_to_string(job.join("logs/merge.out"));
+                    bail!(
+                        "merge job {merge_id}: {state}, no graph\n{}",
+                        log.unwrap_or_default()
+                    );
+                }
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
     }
-}
-
-/// What one engine run measured.
-struct EngineRun {
-    /// Figures of each tile task.
-    tiles: Vec<TileLog>,
-    /// The merge task's log.
-    merge_log: String,
-    /// Plan wall seconds.
-    plan_s: f64,
-    /// Plan CPU seconds.
-    plan_cpu: f64,
-    /// Wall seconds from plan to merged graph.
-    wall: f64,
-    /// Feature store size, bytes.
-    store: u64,
+    Ok(())
 }
 
 /// One engine run of `clips` with bands of `band` frames; checks the merged bytes against
@@ -98,6 +71,7 @@ fn engine_run(
     built: &[u8],
 ) -> Result<EngineRun> {
     let job = dir.join(format!("job-{band}"));
+    std::fs::remove_dir_all(&job).ok();
     let graph = job.join("graph.bin");
     let cpus = std::thread::available_parallelism()
         .map(|n| n.get())
@@ -116,22 +90,27 @@ fn engine_run(
         t0.elapsed().as_secs_f64(),
         cpu_seconds().unwrap_or(f64::NAN) - c0,
     );
+    let ts = Instant::now();
     let out = cluster
         .command("sh")
         .arg(job.join("submit.sh"))
         .env("FIGURINE", exe)
         .output()?;
+    let submit_s = ts.elapsed().as_secs_f64();
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    let merge_id = text
-        .split("merge: job ")
-        .nth(1)
-        .and_then(|s| s.split_whitespace().next())
-        .with_context(|| format!("submit.sh: {text}{}", String::from_utf8_lossy(&out.stderr)))?
-        .to_string();
-    let state = cluster
-        .wait_job(&merge_id, Duration::from_secs(1800))
-        .map_err(anyhow::Error::msg)?;
+    let id = |key: &str| {
+        text.split(key)
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .map(str::to_string)
+            .with_context(|| format!("submit.sh: {text}{}", String::from_utf8_lossy(&out.stderr)))
+    };
+    let (array_id, merge_id) = (id("tiles: job ")?, id("merge: job ")?);
+    wait_for_graph(cluster, &merge_id, &graph, &job)?;
     let wall = t0.elapsed().as_secs_f64();
+    let state = cluster
+        .wait_job(&merge_id, Duration::from_secs(60))
+        .map_err(anyhow::Error::msg)?;
     let merge_log = std::fs::read_to_string(job.join("logs/merge.out")).unwrap_or_default();
     if state != "COMPLETED" {
         bail!("merge job {merge_id}: {state}\n{merge_log}");
@@ -142,19 +121,28 @@ fn engine_run(
     let tiles = (0..planned.manifest.tiles.len())
         .map(|i| tile_log(&job, i))
         .collect::<Result<Vec<_>>>()?;
+    let slurm = std::fs::read_to_string(cluster.controller_log())
+        .ok()
+        .and_then(|log| timeline(&log, &array_id, &merge_id));
     Ok(EngineRun {
         tiles,
         merge_log,
         plan_s,
+        features_s: planned.features_seconds,
+        write_s: planned.write_seconds,
         plan_cpu,
+        submit_s,
         wall,
         store: planned.store_bytes,
+        slurm,
     })
 }
 
-/// Runs the comparison for each band of `bands` (frames) and prints every figure; with
-/// `model_too`, also the scale model for 4 M frames from the last band's run.
-pub fn run(clips: &[GraphClip], bands: &[usize], model_too: bool) -> Result<()> {
+/// Runs the comparison for each band of `bands` (frames), `runs` times over (each time
+/// `graph build` first, then every band, so each run's overhead compares like conditions),
+/// and prints every figure, then the medians; with `model_too`, also the scale model for 4 M
+/// frames from the last band's runs.
+pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -> Result<()> {
     let n: usize = clips.iter().map(|c| c.len()).sum();
     let exe = std::env::current_exe()?
         .parent()
@@ -167,91 +155,89 @@ pub fn run(clips: &[GraphClip], bands: &[usize], model_too: bool) -> Result<()> 
     let dir = std::env::temp_dir().join(format!("figurine-graph-engine-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let p = BuildParams::default();
-
-    let t = Instant::now();
-    let c0 = cpu_seconds().unwrap_or(f64::NAN);
-    let (g, st) = build_graph(clips, &p)?;
-    let built_path = dir.join("build.bin");
-    g.save(&built_path)?;
-    let build_s = t.elapsed().as_secs_f64();
-    let build_cpu = cpu_seconds().unwrap_or(f64::NAN) - c0;
-    let built = std::fs::read(&built_path)?;
-    let edges = g.count(Variant::Mg, None, None);
-    println!(
-        "graph build, {n} frames: {build_s:.2} s, cpu {build_cpu:.2} s (LMA {:.2} s, posture {:.2} s, style {:.2} s), peak {:.0} MiB; {} local maxima, {edges} MG edges",
-        st.lma_seconds,
-        st.posture_seconds,
-        st.style_seconds,
-        peak_memory_mib().unwrap_or(f64::NAN),
-        st.local_minima,
-    );
-
     let cluster = match Cluster::start(&dir.join("cluster")) {
-        Ok(c) => c,
+        Ok(c) => Some(c),
         Err(why) => {
             println!("engine: skipped ({why})");
-            std::fs::remove_dir_all(&dir).ok();
-            return Ok(());
+            None
         }
     };
     let mut fits: Vec<(f64, f64)> = Vec::new();
     let mut model: Option<(f64, f64, f64, f64, f64)> = None;
     let (mut merge_read, mut merge_style) = (f64::NAN, f64::NAN);
-    println!(
-        "\n{:>6} {:>5} | {:>6} {:>8} {:>6} {:>6} | {:>7} {:>6} | {:>6} {:>6} {:>6} {:>5} | {:>6} {:>6} {:>5}",
-        "band", "tiles", "plan s", "engine s", "wall+", "gap s", "cpu s", "cpu+", "tile s", "max s", "cpu s", "MiB", "merge s", "cpu s", "MiB"
-    );
-    for &band in bands {
-        let EngineRun {
-            tiles,
-            merge_log,
-            plan_s,
-            plan_cpu,
-            wall,
-            store,
-        } = engine_run(&cluster, clips, band, &exe, &dir, &built)?;
-        let k = tiles.len() as f64;
-        let work: f64 = tiles.iter().map(|t| t.read_s + t.search_s).sum();
-        let tiles_cpu: f64 = tiles.iter().map(|t| t.cpu_s).sum();
-        let merge_s = after(&merge_log, "total ").unwrap_or(f64::NAN);
-        let merge_cpu = after(&merge_log, "cpu ").unwrap_or(f64::NAN);
-        let merge_mib = after(&merge_log, "peak ").unwrap_or(f64::NAN);
-        // What Slurm added: wall time that is neither plan, tile work nor merge, per task.
-        let gap = (wall - plan_s - work - merge_s) / (k + 1.0);
-        let cpu = plan_cpu + tiles_cpu + merge_cpu;
-        let max = tiles
-            .iter()
-            .map(|t| t.read_s + t.search_s)
-            .fold(0.0, f64::max);
-        let peak = tiles.iter().map(|t| t.peak_mib).fold(0.0, f64::max);
+    let mut rows: Vec<Vec<Row>> = vec![Vec::new(); bands.len()];
+    let mut tiles_of = vec![0usize; bands.len()];
+    let mut st = BuildStats::default();
+    let mut edges = 0;
+    let runs = runs.max(1);
+    for rep in 0..runs {
+        let t = Instant::now();
+        let c0 = cpu_seconds().unwrap_or(f64::NAN);
+        let (g, stats) = build_graph(clips, &p)?;
+        let built_path = dir.join("build.bin");
+        g.save(&built_path)?;
+        let build_s = t.elapsed().as_secs_f64();
+        let build_cpu = cpu_seconds().unwrap_or(f64::NAN) - c0;
+        let built = std::fs::read(&built_path)?;
+        edges = g.count(Variant::Mg, None, None);
         println!(
-            "{band:>6} {:>5} | {plan_s:>6.2} {wall:>8.2} {:>5.0}% {gap:>6.2} | {cpu:>7.2} {:>5.0}% | {:>6.2} {max:>6.2} {:>6.2} {peak:>5.0} | {merge_s:>6.2} {merge_cpu:>6.2} {merge_mib:>5.0}",
-            tiles.len(),
-            100.0 * (wall / build_s - 1.0),
-            100.0 * (cpu / build_cpu - 1.0),
-            work / k,
-            tiles_cpu / k,
+            "{}graph build, {n} frames: {build_s:.2} s, cpu {build_cpu:.2} s (LMA {:.2} s, posture {:.2} s, style {:.2} s), peak {:.0} MiB; {} local maxima, {edges} MG edges",
+            if runs > 1 { format!("run {}/{runs}: ", rep + 1) } else { String::new() },
+            stats.lma_seconds,
+            stats.posture_seconds,
+            stats.style_seconds,
+            peak_memory_mib().unwrap_or(f64::NAN),
+            stats.local_minima,
         );
-        fits.push((band as f64, peak));
-        let pairs: f64 = tiles.iter().map(|t| t.pairs).sum();
-        // Per pair and per frame read, CPU seconds (all the tile's CPU time is put on its pairs).
-        let read_per_frame = tiles.iter().map(|t| t.read_s).sum::<f64>() / (k * 2.0 * band as f64);
-        model = Some((
-            tiles_cpu / pairs,
-            read_per_frame,
-            gap,
-            plan_cpu,
-            store as f64,
-        ));
-        if band == bands[0] {
-            println!(
-                "        feature store {:.1} MiB for {n} frames = {:.0} MiB per million frames ({BYTES_PER_FRAME} bytes of values per frame)",
-                store as f64 / 1048576.0,
-                store as f64 / n as f64 * 1e6 / 1048576.0
-            );
-            println!("        merge: {}", merge_log.trim());
-            merge_read = after(&merge_log, "read ").unwrap_or(f64::NAN);
-            merge_style = after(&merge_log, "style ").unwrap_or(f64::NAN);
+        st = stats;
+        let Some(cluster) = &cluster else {
+            std::fs::remove_dir_all(&dir).ok();
+            return Ok(());
+        };
+        println!(
+            "\n{:>6} {:>5} | {:>7} {:>6} {:>8} {:>6} {:>6} | {:>7} {:>6} | {:>6} {:>6} {:>6} {:>5} | {:>7} {:>6} {:>5}",
+            "band", "tiles", "build s", "plan s", "engine s", "wall+", "gap s", "cpu s", "cpu+", "tile s", "max s", "cpu s", "MiB", "merge s", "cpu s", "MiB"
+        );
+        for (b, &band) in bands.iter().enumerate() {
+            let r = engine_run(cluster, clips, band, &exe, &dir, &built)?;
+            let row = Row::of(&r, build_s, build_cpu);
+            row.print(&band.to_string(), r.tiles.len());
+            tiles_of[b] = r.tiles.len();
+            let k = r.tiles.len() as f64;
+            let tiles_cpu: f64 = r.tiles.iter().map(|t| t.cpu_s).sum();
+            if rep == 0 {
+                fits.push((band as f64, row.peak));
+            }
+            let pairs: f64 = r.tiles.iter().map(|t| t.pairs).sum();
+            // Per pair and per frame read, CPU seconds (all the tile's CPU time is put on its
+            // pairs).
+            let read_per_frame =
+                r.tiles.iter().map(|t| t.read_s).sum::<f64>() / (k * 2.0 * band as f64);
+            model = Some((
+                tiles_cpu / pairs,
+                read_per_frame,
+                row.gap,
+                r.plan_cpu,
+                r.store as f64,
+            ));
+            if b == 0 && rep == 0 {
+                println!(
+                    "        feature store {:.1} MiB for {n} frames = {:.0} MiB per million frames ({BYTES_PER_FRAME} bytes of values per frame)",
+                    r.store as f64 / 1048576.0,
+                    r.store as f64 / n as f64 * 1e6 / 1048576.0
+                );
+                println!("        merge: {}", r.merge_log.trim());
+                merge_read = after(&r.merge_log, "read ").unwrap_or(f64::NAN);
+                merge_style = after(&r.merge_log, "style ").unwrap_or(f64::NAN);
+            }
+            rows[b].push(row);
+        }
+        println!();
+    }
+    if runs > 1 {
+        println!("medians of {runs} runs:");
+        for (b, &band) in bands.iter().enumerate() {
+            Row::median(&rows[b]).print(&band.to_string(), tiles_of[b]);
         }
     }
     drop(cluster);

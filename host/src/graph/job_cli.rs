@@ -111,13 +111,14 @@ pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
 pub(super) fn tile_cmd(a: TileArgs) -> anyhow::Result<()> {
     let r = run_tile(&a.job, a.index, !a.quiet)?;
     println!(
-        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.2} s, search {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.3} s, search {:.3} s, write {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
         a.index,
         r.kernels,
         r.found.pairs,
         r.found.candidates.len(),
         r.read_seconds,
         r.search_seconds,
+        r.write_seconds,
         cpu_seconds().unwrap_or(f64::NAN),
         peak_memory_mib().unwrap_or(f64::NAN),
         r.path.display()
@@ -145,7 +146,7 @@ pub(super) fn merge_cmd(a: MergeArgs) -> anyhow::Result<()> {
     })?;
     if !a.quiet {
         println!(
-            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.2} s, style {:.2} s, total {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.3} s, style {:.3} s, total {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
             st.tiles,
             st.pairs,
             st.local_minima,

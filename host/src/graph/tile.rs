@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use super::build::progress_bar;
 use super::plan::{
-    read_manifest, tile_path, write_atomic, Manifest, TileSpec, JOB_VERSION, STORE_FILE,
+    read_manifest, tile_path, write_atomic, Manifest, TileSpec, CRC64, JOB_VERSION, STORE_FILE,
 };
 use super::search::{band_frames, search, Candidate, Found, Layout};
 use super::store::Store;
@@ -57,8 +57,6 @@ mod field {
 }
 /// Bytes before the body.
 pub const HEADER_LEN: usize = field::CRC.end;
-
-const CRC64: crc::Crc<u64> = crc::Crc::<u64>::new(&crc::CRC_64_ECMA_182);
 
 /// A tile file's content.
 #[derive(Debug, Clone, PartialEq)]
@@ -272,10 +270,13 @@ pub struct TileRun {
     pub read_seconds: f64,
     /// Seconds of the search.
     pub search_seconds: f64,
+    /// Seconds writing the tile file.
+    pub write_seconds: f64,
 }
 
 /// Runs tile `index` of job folder `job` and writes its file (atomically).
 pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, GraphError> {
+    let t0 = Instant::now();
     let m = read_manifest(job)?;
     let spec = *m.tiles.get(index).ok_or_else(|| {
         GraphError::Invalid(format!(
@@ -284,7 +285,6 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
             m.tiles.len().saturating_sub(1)
         ))
     })?;
-    let t0 = Instant::now();
     let store = Store::open(&job.join(STORE_FILE), m.plan_id(), m.frames)?;
     let n = m.frames;
     let row_frames = band_frames(spec.rows[0]..spec.rows[1], n);
@@ -315,6 +315,7 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
         plan: m.plan_id(),
         found,
     };
+    let t2 = Instant::now();
     let path = tile_path(job, index);
     write_atomic(&path, &encode_tile(&file))?;
     Ok(TileRun {
@@ -323,6 +324,7 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
         kernels: kernels.len(),
         read_seconds,
         search_seconds,
+        write_seconds: t2.elapsed().as_secs_f64(),
     })
 }
 
