@@ -14,6 +14,16 @@
 //! The job folder must be on a file system every node sees, and `figurine` at the same path
 //! on every node (or named by the `FIGURINE` environment variable at submission; sbatch
 //! passes the environment on).
+//!
+//! What Slurm adds to a job's time is its scheduling latency, which the cluster's slurm.conf
+//! decides, not the scripts. slurmctld never starts a batch job on its submission: its
+//! background loop starts pending jobs once a second, after `batch_sched_delay` (default 3 s)
+//! has passed. A job ending triggers a scheduling pass at once only through the epilog's
+//! completion message, so on a cluster without any `Epilog` a dependent job (the merge) and
+//! array tasks waiting for a free node also wait for that loop (Slurm 22.05 to 25.11). With
+//! `batch_sched_delay=0` and an `Epilog` (most sites have one), the tiles start within a
+//! second of `submit.sh` and the merge within a tenth of a second of the last tile; the
+//! test cluster of `tests/support/slurm.rs` is set up that way.
 
 use std::path::Path;
 
