@@ -149,6 +149,9 @@ impl Row {
                             - after(&r.merge_log, "style ").unwrap_or(f64::NAN),
                     ),
                     ("Slurm: merge start + end", merge_slurm - merge),
+                    // What the other stages leave: the graph file appears a few hundredths
+                    // of a second before slurmctld logs the merge's end, so this is
+                    // slightly negative when nothing else is lost.
                     ("rest", r.wall - r.plan_s - r.submit_s - s.span),
                 ]);
             }
