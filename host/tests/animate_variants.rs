@@ -235,6 +235,7 @@ fn synthetic_loop(frames: usize) -> ActionClip {
         effort: None,
         alternatives: Vec::new(),
         ranges: None,
+        mirrored: None,
     }
 }
 

@@ -43,6 +43,7 @@ use super::effort::{apply_effort, Effort, EffortClip};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
+use super::mirror::pick_side;
 use super::pacing::{ground_travel, pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
@@ -310,6 +311,16 @@ pub fn assemble_guided(
             },
             guide,
         );
+        // A clip stepping to one side steps towards the side the doodle moves.
+        let ac = match &path {
+            Some(p) if ac.moving => pick_side(
+                ac,
+                &p.chunk(ev.start as f32, ev.end as f32),
+                cursor.heading,
+                forward,
+            ),
+            _ => ac,
+        };
         // Caches are per variant.
         let key = format!("{}\u{0}{}", ev.action, ac.variant);
         let mut f0 = frame_of(ev.start);

@@ -152,6 +152,15 @@ pub enum ClipCommand {
         #[arg(long, default_value = "1,0,0")]
         forward: String,
     },
+    /// Search motion-capture takes for sideways stepping (see [`super::sideways`]).
+    Sideways {
+        /// .bvh files or DeepMimic .txt/.json files.
+        #[arg(required = true)]
+        takes: Vec<PathBuf>,
+        /// URDF for DeepMimic files (default: the data folder's humanoid.urdf).
+        #[arg(long)]
+        urdf: Option<PathBuf>,
+    },
 }
 
 /// Runs `figurine animate`.
@@ -415,6 +424,9 @@ pub fn run_clip(args: &ClipArgs) -> anyhow::Result<()> {
         }
         ClipCommand::Variants { clips, graph } => {
             print_variants(clips.as_deref(), graph.as_deref())
+        }
+        ClipCommand::Sideways { takes, urdf } => {
+            super::sideways::run_sideways(takes, urdf.as_deref())
         }
         ClipCommand::Plot {
             clip,

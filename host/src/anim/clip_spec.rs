@@ -41,9 +41,27 @@ pub struct ActionSpec {
     /// file's `"Loop": "wrap"` for whole files, else `cyclic`).
     #[serde(default, rename = "loop")]
     pub looping: Option<bool>,
+    /// Retarget the clip from its own rig (a BVH take's) onto the library's skeleton (see
+    /// [`super::retarget`]): clips of one library must share one skeleton.
+    #[serde(default)]
+    pub retarget: Option<RetargetSpec>,
+    /// The clip steps to one side: its mirror image ([`super::mirror`]) is loaded too, and a
+    /// moving action plays whichever keeps the character facing nearest its heading, so it
+    /// steps towards the side the doodle moves.
+    #[serde(default)]
+    pub both_sides: bool,
     /// Why this clip was chosen (substitutions are documented here).
     #[serde(default)]
     pub note: Option<String>,
+}
+
+/// How a clip from another rig is retargeted onto the library's skeleton.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RetargetSpec {
+    /// A frame of the source file where the performer stands in a T-pose facing forward (it
+    /// calibrates each joint's twist; LAFAN1 takes open with one at frame 0).
+    pub tpose: usize,
 }
 
 impl ActionSpec {

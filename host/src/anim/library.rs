@@ -15,7 +15,10 @@
 //! plays it backwards then forwards, `anchor` keeps an in-place clip that travels on its spot,
 //! `scale` turns a BVH clip's unit into metres (default
 //! 0.01 for `.bvh`, 1 for DeepMimic). `forward` is the direction the rig faces, in its root
-//! joint's frame.
+//! joint's frame. `"retarget": {"tpose": F}` plays a BVH take of another rig on the library's
+//! skeleton ([`super::retarget`]; frame F of the file is the performer's T-pose), and
+//! `"both_sides": true` loads a clip that steps to one side with its mirror image
+//! ([`super::mirror`]), playing whichever steps towards the side the doodle moves.
 //!
 //! **Variants.** An action may instead list several clips, e.g. a plain kick and a spinning
 //! kick: `"kick": [ {"name": "kick", "file": …}, {"name": "spinkick", "file": …} ]`. Each
@@ -33,10 +36,12 @@
 //! `pingpong`), `cyclic` otherwise. Moving actions that are not cyclic (jumps) play once.
 //! Files resolve relative to the library file first, then as `KIND/NAME` in the project's data
 //! folder ([`crate::data::data_file`]). All clips must share one skeleton (transitions blend
-//! poses joint by joint). The default library (`host/assets/default_clips.json`, built into the
-//! binary) maps the recogniser's default actions onto pybullet's DeepMimic clips, with variants
-//! for kick, jump and wave; `host/assets/lafan_clips.json` maps walk onto three LAFAN1 gait
-//! cycles and wave onto three dance stretches, each of different vigour.
+//! poses joint by joint): a take of another rig is retargeted onto it. The default library
+//! (`host/assets/default_clips.json`, built into the binary) maps the recogniser's default
+//! actions onto pybullet's DeepMimic clips, with variants for kick, jump and wave, and
+//! sidestep onto a LAFAN1 take's sideways steps, retargeted and mirrored;
+//! `host/assets/lafan_clips.json` maps walk onto three LAFAN1 gait cycles and wave onto three
+//! dance stretches, each of different vigour.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -48,6 +53,8 @@ use serde::Deserialize;
 use super::clip_spec::check_variants;
 pub use super::clip_spec::{ActionEntry, ActionSpec, MAX_VARIANTS};
 use super::joint_limits::JointRanges;
+use super::mirror::{mirror, MIRRORED_SUFFIX};
+use super::retarget::retarget;
 use super::variant_effort::variant_efforts;
 use super::AnimError;
 use crate::graph::GraphError;
@@ -128,6 +135,9 @@ pub struct ActionClip {
     /// [`super::joint_limits::JointRanges`]): effort transfer holds the joints within it.
     /// `None` for clips built outside a library.
     pub ranges: Option<Arc<JointRanges>>,
+    /// The clip's mirror image, for clips that step to one side (`both_sides`; see
+    /// [`super::mirror::pick_side`]).
+    pub mirrored: Option<Box<ActionClip>>,
 }
 
 impl ActionClip {
@@ -260,10 +270,7 @@ impl ClipLibrary {
         let wanted: Vec<&str> = actions.into_iter().collect();
         let (mut out, ranges) = self.with_joint_ranges(&wanted)?;
         for ac in out.values_mut() {
-            ac.ranges = Some(ranges.clone());
-            for alt in &mut ac.alternatives {
-                alt.ranges = Some(ranges.clone());
-            }
+            set_ranges(ac, &ranges);
         }
         Ok(out)
     }
@@ -286,7 +293,11 @@ impl ClipLibrary {
         }
         let pool = |clips: &BTreeMap<String, ActionClip>| {
             Arc::new(JointRanges::learn(
-                clips.values().flat_map(|a| a.variants()).map(|v| &v.clip),
+                clips
+                    .values()
+                    .flat_map(|a| a.variants())
+                    .flat_map(|v| std::iter::once(v).chain(v.mirrored.as_deref()))
+                    .map(|v| &v.clip),
             ))
         };
         self.check_actions(wanted.iter().copied())?;
@@ -425,10 +436,31 @@ impl ClipLibrary {
             Some([a, b]) => (a as f32 * clip.frame_time, b as f32 * clip.frame_time),
             None => (0.0, clip.duration()),
         };
-        select_frames(&mut clip, spec, &self.origin, action)?;
+        if let Some(rt) = &spec.retarget {
+            let (target, _) = urdf.ok_or_else(|| {
+                AnimError::Data(format!(
+                    "{}: action {action}: retargeting {} needs the library's \"skeleton\"",
+                    self.origin, spec.file
+                ))
+            })?;
+            let range = spec
+                .frames
+                .unwrap_or([0, clip.frames.len().saturating_sub(1)]);
+            clip = retarget(&clip, rt.tpose, range, target)
+                .map_err(|e| AnimError::Data(format!("{}: action {action}: {e}", self.origin)))?;
+            clip.name = action.to_string();
+            // The range is cut already.
+            let whole = ActionSpec {
+                frames: None,
+                ..spec.clone()
+            };
+            select_frames(&mut clip, &whole, &self.origin, action)?;
+        } else {
+            select_frames(&mut clip, spec, &self.origin, action)?;
+        }
         let whole = spec.frames.is_none() && !spec.pingpong;
         let looping = spec.looping.unwrap_or(spec.cyclic || (whole && file_loops));
-        Ok(ActionClip {
+        let mut ac = ActionClip {
             action: action.to_string(),
             variant: spec.variant_name(),
             clip,
@@ -442,7 +474,27 @@ impl ClipLibrary {
             effort: None,
             alternatives: Vec::new(),
             ranges: None,
-        })
+            mirrored: None,
+        };
+        if spec.both_sides {
+            let mut m = ac.clone();
+            m.clip = mirror(&ac.clip)
+                .map_err(|e| AnimError::Data(format!("{}: action {action}: {e}", self.origin)))?;
+            m.variant = format!("{}{MIRRORED_SUFFIX}", ac.variant);
+            ac.mirrored = Some(Box::new(m));
+        }
+        Ok(ac)
+    }
+}
+
+/// Gives a clip, its mirror image and its alternatives the library's joint ranges.
+fn set_ranges(ac: &mut ActionClip, ranges: &Arc<JointRanges>) {
+    ac.ranges = Some(ranges.clone());
+    if let Some(m) = &mut ac.mirrored {
+        set_ranges(m, ranges);
+    }
+    for alt in &mut ac.alternatives {
+        set_ranges(alt, ranges);
     }
 }
 

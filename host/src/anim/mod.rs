@@ -2,7 +2,8 @@
 //! doodle's path to a full-body character animation.
 //!
 //! Data flow, one file per stage:
-//! [`library`] (action → clip variants; an entry's format in [`clip_spec`]) →
+//! [`library`] (action → clip variants; an entry's format in [`clip_spec`]; takes of other rigs
+//! [`retarget`]ed onto its skeleton, clips that step to one side [`mirror`]ed for the other) →
 //! [`variants`] (the variant matching the recognised effort, each variant's own effort measured
 //! by [`variant_effort`]) →
 //! [`phrasing`] (stages of each clip, §6.1) →
@@ -16,7 +17,8 @@
 //! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
 //! [`plot`] draws contact sheets to look at the result; [`check`] (`figurine check`) judges
 //! it against real motion capture (penetration, floating, skating, joints bent backwards)
-//! within the bounds of [`envelope`], which [`pacing`] holds a path to as well.
+//! within the bounds of [`envelope`], which [`pacing`] holds a path to as well. [`sideways`]
+//! (`figurine clip sideways`) searches takes for sideways stepping to cut a sidestep from.
 
 use std::path::PathBuf;
 
@@ -36,9 +38,12 @@ pub mod graph_cuts;
 pub mod joint_limits;
 pub mod library;
 pub mod looping;
+pub mod mirror;
 pub mod pacing;
 pub mod phrasing;
 pub mod plot;
+pub mod retarget;
+pub mod sideways;
 pub mod trajectory;
 pub mod transition;
 pub mod variant_effort;

@@ -239,6 +239,7 @@ mod tests {
             effort: None,
             alternatives: Vec::new(),
             ranges: None,
+            mirrored: None,
         }
     }
 
