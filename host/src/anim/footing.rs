@@ -98,14 +98,10 @@ pub fn clear_swing_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) -
                 .iter()
                 .filter_map(|&j| world.get(j).map(|p| p.y))
                 .fold(f32::INFINITY, f32::min);
-            let short = GROUND_Y + want - low;
-            if !(short > 0.0 && short.is_finite()) {
+            if !(low < GROUND_Y + want) {
                 continue;
             }
-            let Some(&ankle) = world.get(leg.ankle) else {
-                continue;
-            };
-            two_bone_ik(&sk, pose, leg, ankle + Vec3::Y * short);
+            set_foot_height(&sk, pose, leg, GROUND_Y + want);
             lifted += 1;
         }
     }
@@ -122,8 +118,9 @@ pub const RAISE_EASE_FRAMES: usize = 4;
 /// (each window maximum averaged saw it) and changes evenly. Raised in one frame alone, the
 /// body would pop up by the need and back (a strong run whose amplified leg cannot reach the
 /// ground where the run lands it moved its root at 4.4 m/s). A foot that stood on the ground
-/// before its frame was raised is set back down by two-bone IK as far as its leg reaches (the
-/// frames around keep their feet on the floor; the frames in need keep theirs at it).
+/// before its frame was raised is set back down by two-bone IK as far as its leg reaches, in
+/// the frames around whose legs had slack (they keep their feet on the floor; the frames in
+/// need have theirs raised onto it).
 pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
     let n = clip.len().min(need.len());
     let window =
@@ -148,19 +145,37 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
                 .iter()
                 .filter_map(|&j| before.get(j).map(|p| p.y))
                 .fold(f32::INFINITY, f32::min);
-            // Only feet on (or in) the ground come back down, and no lower than it.
-            if !(low < GROUND_Y + CONTACT_HEIGHT) {
+            // Only feet on the ground come back down, in frames whose legs had the slack (a
+            // frame in need keeps its feet where the raise put them: on the ground).
+            if !(low < GROUND_Y + CONTACT_HEIGHT) || need[f] > 0.0 {
                 continue;
             }
-            let drop = raise - (GROUND_Y - low).max(0.0);
-            let Some(&ankle) = before.get(leg.ankle) else {
-                continue;
-            };
-            if drop > 1e-5 {
-                let at = ankle + Vec3::Y * (raise - drop);
-                two_bone_ik(&sk, pose, leg, at);
-            }
+            set_foot_height(&sk, pose, leg, low.max(GROUND_Y));
         }
+    }
+}
+
+/// Moves the ankle of `leg` up or down by two-bone IK so that the foot's lowest point comes to
+/// height `y` (m), as near as the leg reaches (IK keeps the foot's orientation, so the ankle
+/// moves by what the lowest point must).
+fn set_foot_height(
+    sk: &crate::motion::Skeleton,
+    pose: &mut crate::motion::Pose,
+    leg: &Leg,
+    y: f32,
+) {
+    let world = sk.positions(pose);
+    let low = leg
+        .foot
+        .iter()
+        .filter_map(|&j| world.get(j).map(|p| p.y))
+        .fold(f32::INFINITY, f32::min);
+    let off = low - y;
+    let Some(&ankle) = world.get(leg.ankle) else {
+        return;
+    };
+    if off.is_finite() && off.abs() > 1e-5 {
+        two_bone_ik(sk, pose, leg, ankle - Vec3::Y * off);
     }
 }
 
@@ -171,9 +186,9 @@ mod tests {
     use crate::motion::{Joint, Pose, Skeleton};
     use glam::Quat;
 
-    /// One leg standing with its toe on the ground, the knee a little bent; `frames` frames at
-    /// 30 fps, the foot swept along +Z at `speed` m/s (the hip carried with it).
-    fn sweeping_leg(frames: usize, speed: f32) -> Clip {
+    /// One leg standing with its toe on the ground, the knee bent `knee` rad; `frames` frames
+    /// at 30 fps, the foot swept along +Z at `speed` m/s (the hip carried with it).
+    fn sweeping_leg(frames: usize, speed: f32, knee: f32) -> Clip {
         let j = Joint::bare;
         let sk = Skeleton {
             joints: vec![
@@ -186,7 +201,7 @@ mod tests {
             ],
         };
         let mut rest = Pose::rest(&sk);
-        rest.rotations[2] = Quat::from_rotation_x(0.2);
+        rest.rotations[2] = Quat::from_rotation_x(knee);
         let toe = sk.positions(&rest)[4].y;
         let poses = (0..frames)
             .map(|f| {
@@ -210,12 +225,12 @@ mod tests {
 
     #[test]
     fn a_foot_standing_still_is_planted_even_where_its_source_was_not() {
-        let c = sweeping_leg(10, 0.0);
+        let c = sweeping_leg(10, 0.0, 0.2);
         let legs = find_legs(&c);
         let flags = planted(&c, &legs, &[vec![false; 10]]);
         assert_eq!(flags, vec![vec![true; 10]]);
         // A foot sweeping at 2 m/s is no contact, but the source's contacts are kept.
-        let c = sweeping_leg(10, 2.0);
+        let c = sweeping_leg(10, 2.0, 0.2);
         let mut source = vec![false; 10];
         source[4] = true;
         let flags = planted(&c, &legs, &[source.clone()]);
@@ -224,7 +239,7 @@ mod tests {
 
     #[test]
     fn a_foot_sweeping_along_the_floor_is_lifted_clear_of_it_and_a_planted_one_is_not() {
-        let mut c = sweeping_leg(12, 2.0);
+        let mut c = sweeping_leg(12, 2.0, 0.2);
         let legs = find_legs(&c);
         let hip_before: Vec<Vec3> = (0..12).map(|f| c.joint_positions(f)[1]).collect();
         // Planted in frames 0–1, swinging after.
@@ -250,8 +265,11 @@ mod tests {
 
     #[test]
     fn a_raise_is_spread_over_the_frames_around_and_their_feet_stay_down() {
-        let mut c = sweeping_leg(21, 0.0);
+        // A knee bent 0.6 rad: 4 cm of slack before the leg is straight.
+        let mut c = sweeping_leg(21, 0.0, 0.6);
         let legs = find_legs(&c);
+        // Frame 10's foot is 4 cm into the ground where its leg could not reach.
+        c.frames[10].translations[0].y -= 0.04;
         let mut need = vec![0.0; 21];
         need[10] = 0.04;
         let root_before: Vec<f32> = (0..21).map(|f| c.frames[f].translations[0].y).collect();
@@ -268,10 +286,11 @@ mod tests {
         }
         assert_eq!(raise[0], 0.0);
         assert_eq!(raise[20], 0.0);
-        // The bent knee has the slack to keep the raised frames' foot on the ground.
+        // The frame in need stands on the ground, and the bent knee has the slack to keep the
+        // foot of the frames around on it (IK lands it within millimetres).
         for f in 0..21 {
             assert!(
-                toe_height(&c, f).abs() < 1e-3,
+                toe_height(&c, f).abs() < 3e-3,
                 "frame {f}: {}",
                 toe_height(&c, f)
             );
