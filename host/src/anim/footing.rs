@@ -150,9 +150,27 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
             if !(low < GROUND_Y + CONTACT_HEIGHT) || need[f] > 0.0 {
                 continue;
             }
+            // IK on a leg near straight first bends its knee forward, which tips the foot: a
+            // foot that would end below the ground stays where the raise put it instead.
+            let kept = pose.rotations.clone();
             set_foot_height(&sk, pose, leg, low.max(GROUND_Y));
+            if lowest_point(&sk.positions(pose), leg) < GROUND_Y - SINK_TOLERANCE_M {
+                pose.rotations = kept;
+            }
         }
     }
+}
+
+/// How far below the ground (m) [`raise_evenly`] lets a foot it sets back down end (IK lands a
+/// foot within a fraction of a millimetre of its target when the leg has slack).
+const SINK_TOLERANCE_M: f32 = 1e-3;
+
+/// The height (m) of the lowest point of `leg`'s foot among world positions `world`.
+fn lowest_point(world: &[Vec3], leg: &Leg) -> f32 {
+    leg.foot
+        .iter()
+        .filter_map(|&j| world.get(j).map(|p| p.y))
+        .fold(f32::INFINITY, f32::min)
 }
 
 /// Moves the ankle of `leg` up or down by two-bone IK so that the foot's lowest point comes to
