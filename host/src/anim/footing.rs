@@ -17,8 +17,10 @@
 //!   the rest of the body keep their motion), rising to it over [`CLEARANCE_EASE_FRAMES`] frames
 //!   after it leaves the ground and lowering as it comes back, as a foot lifts off.
 //!
-//! Only the legs below the hips change: the effort (timing, amplitude of the arms and the
-//! torso, the root's path) is kept.
+//! Both change only the legs below the hips: the effort (timing, amplitude of the arms and the
+//! torso, the root's path) is kept. And where the ground pass must raise the root because a
+//! leg cannot reach the ground, [`raise_evenly`] spreads the raise over the frames around
+//! rather than popping the body up for one frame.
 
 use glam::Vec3;
 
@@ -27,7 +29,7 @@ use crate::motion::Clip;
 
 /// Least height (m) of a swinging foot's lowest point above the ground: the height under which
 /// a foot can be planted ([`CONTACT_HEIGHT`]), so a foot moving too fast to stand is never low
-/// enough to be taken for one standing (real walkers' swinging feet clear the floor by 2–10 cm).
+/// enough to be taken for one standing.
 pub const SWING_CLEARANCE_M: f32 = CONTACT_HEIGHT;
 
 /// Frames over which a foot leaving the ground rises to [`SWING_CLEARANCE_M`] (and lowers from
@@ -98,7 +100,7 @@ pub fn clear_swing_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) -
                 .iter()
                 .filter_map(|&j| world.get(j).map(|p| p.y))
                 .fold(f32::INFINITY, f32::min);
-            if !(low < GROUND_Y + want) {
+            if low.is_nan() || low >= GROUND_Y + want {
                 continue;
             }
             set_foot_height(&sk, pose, leg, GROUND_Y + want);
@@ -147,7 +149,7 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
                 .fold(f32::INFINITY, f32::min);
             // Only feet on the ground come back down, in frames whose legs had the slack (a
             // frame in need keeps its feet where the raise put them: on the ground).
-            if !(low < GROUND_Y + CONTACT_HEIGHT) || need[f] > 0.0 {
+            if low.is_nan() || low >= GROUND_Y + CONTACT_HEIGHT || need[f] > 0.0 {
                 continue;
             }
             // IK on a leg near straight first bends its knee forward, which tips the foot: a
@@ -268,7 +270,7 @@ mod tests {
         assert_eq!(lifted, 10);
         assert!(toe_height(&c, 0).abs() < 1e-5 && toe_height(&c, 1).abs() < 1e-5);
         // It rises over CLEARANCE_EASE_FRAMES, then keeps the full clearance.
-        for f in 2..12 {
+        for (f, hip) in hip_before.iter().enumerate().skip(2) {
             let share = ((f - 1) as f32 / CLEARANCE_EASE_FRAMES as f32).min(1.0);
             let want = SWING_CLEARANCE_M * share;
             assert!(
@@ -277,7 +279,7 @@ mod tests {
                 toe_height(&c, f)
             );
             // The hip did not move: the knee bent.
-            assert!((c.joint_positions(f)[1] - hip_before[f]).length() < 1e-5);
+            assert!((c.joint_positions(f)[1] - *hip).length() < 1e-5);
         }
     }
 
