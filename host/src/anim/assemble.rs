@@ -30,9 +30,11 @@
 //! fast stretches borrow time from the slow ones ([`super::effort::EffortClip::paced`]).
 //! Between consecutive actions the best frames by windowed posture distance are joined by a
 //! smooth blend; after the last action the final pose is held for [`AssembleOptions::hold_s`].
-//! Finally feet are pinned where the source clips plant them (two-bone IK holds each planted
-//! foot where its contact began, undoing slides from rescaling, path stretching and blends),
-//! and ground penetration is removed with two-bone IK.
+//! Finally feet are pinned where the source clips plant them, and where the animation itself
+//! holds a foot low and slow on the ground (two-bone IK holds each planted foot where its
+//! contact began, undoing slides from rescaling, path stretching and blends), every other foot
+//! is lifted clear of the floor ([`super::footing`]), and ground penetration is removed with
+//! two-bone IK.
 
 use std::collections::BTreeMap;
 
@@ -40,11 +42,14 @@ use glam::{Quat, Vec2, Vec3};
 
 use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
 use super::effort::{apply_effort, Effort, EffortClip};
+use super::footing::{clear_swing_feet, planted};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
 use super::mirror::pick_side;
-use super::pacing::{ground_travel, pace, root_speed_max, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM};
+use super::pacing::{
+    ground_travel, pace, root_speed_max, shrink, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM,
+};
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
 use super::transition::{best_pair, blend_world, ease_root, smoothstep, ROOT_EASE_S};
@@ -66,6 +71,11 @@ pub const MAX_OUTPUT_FRAMES: usize = 216_000;
 pub const JOIN_EASE_REACH: usize = 2;
 /// How many times [`assemble`] eases the sharpest change near each join.
 pub const JOIN_EASE_PASSES: usize = 3;
+
+/// Most times [`assemble`] shrinks a gait's path whose root outruns a person at the cycle's
+/// fastest (each by the ratio of the limit to the fastest; the bob, which the path does not
+/// scale, may need a second).
+pub const MAX_PATH_SHRINKS: usize = 4;
 
 /// Share of [`HUMAN_ROOT_SPEED_M_S`] the root may reach where [`assemble`] eases a join
 /// ([`ease_root`]'s `top`): more than the actions are paced to ([`PACE_HEADROOM`]), since a
@@ -136,8 +146,9 @@ pub struct Assembly {
     pub clip: Clip,
     /// One placement per assembled event.
     pub placements: Vec<Placement>,
-    /// Per leg, per frame: the foot is planted (from the source clips' contacts at the frames'
-    /// source times), and was pinned there.
+    /// Per leg, per frame: the foot is planted (the source clips' contacts at the frames'
+    /// source times, and where the assembled animation holds it low and slow on the ground;
+    /// [`super::footing::planted`]), and was pinned there; every other foot clears the ground.
     pub contacts: Vec<Vec<bool>>,
     /// The ground pass's report.
     pub ground: GroundFix,
@@ -379,6 +390,8 @@ pub fn assemble_guided(
         let slowest = f1.max(f0 + (cycles as f32 * ac.clip.duration() * fps).ceil() as usize);
         let start = cursor.clone();
         let mut placed_action;
+        let mut chunk = chunk;
+        let mut shrinks = 0;
         loop {
             if f1 > MAX_OUTPUT_FRAMES {
                 return Err(AnimError::Data(format!(
@@ -390,7 +403,19 @@ pub fn assemble_guided(
             cursor = start.clone();
             placed_action = place_action(ac, &ec, &chunk, &mut cursor, forward, f1 - f0, cycles);
             let fastest = root_speed_max(&placed_action.0, 1.0 / fps);
-            if fastest <= top_speed || f1 >= slowest {
+            if fastest <= top_speed {
+                break;
+            }
+            // A gait's root follows its path: where its bob and surge on top of the path's
+            // pace outrun a person (a strong run's amplified bob drops the root 6 cm in a
+            // frame as it lands), the path is shrunk about its start rather than the gait
+            // slowed past its event (the same cycles, shorter strides).
+            if ac.moving && ac.cyclic && shrinks < MAX_PATH_SHRINKS && chunk.length() > 0.05 {
+                chunk = shrink(&chunk, chunk.length() * top_speed / fastest);
+                shrinks += 1;
+                continue;
+            }
+            if f1 >= slowest {
                 break;
             }
             let n = (f1 - f0) as f32;
@@ -589,7 +614,11 @@ pub fn assemble_guided(
                 .collect()
         })
         .collect();
+    // The feet the animation itself sets down stand too; every other foot clears the floor
+    // (a light effort's shrunken swing would scuff it).
+    let contacts = planted(&clip, &legs, &contacts);
     pin_feet(&mut clip, &legs, &contacts);
+    clear_swing_feet(&mut clip, &legs, &contacts);
     let ground = fix_ground(&mut clip, &legs);
     Ok(Assembly {
         clip,

@@ -379,11 +379,14 @@ pub fn keep_feet_above_floor(src: &Clip, out: &mut Clip) -> usize {
 }
 
 /// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
-/// cannot reach, the root is raised by what remains.
+/// cannot reach, the root is raised by what remains — evenly over the frames around
+/// ([`super::footing::raise_evenly`]), so the body rises and settles as a person's would
+/// rather than popping up for a frame.
 pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
     let mut fix = GroundFix::default();
     let sk = clip.skeleton.clone();
-    for pose in &mut clip.frames {
+    let mut need = vec![0.0f32; clip.len()];
+    for (pose, need) in clip.frames.iter_mut().zip(&mut need) {
         let mut bent = false;
         for leg in legs {
             let world = sk.forward(pose);
@@ -409,14 +412,15 @@ pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
             .map(|&j| world[j].y)
             .fold(f32::INFINITY, f32::min);
         if low < GROUND_Y && low.is_finite() {
-            if let Some(t) = pose.translations.first_mut() {
-                t.y += GROUND_Y - low + 1e-4;
-            }
+            *need = GROUND_Y - low + 1e-4;
             fix.raised_frames += 1;
         }
         if bent {
             fix.ik_frames += 1;
         }
+    }
+    if fix.raised_frames > 0 {
+        super::footing::raise_evenly(clip, legs, &need);
     }
     fix
 }

@@ -13,7 +13,8 @@
 //! [`pacing`] (cycles at a human cadence, paths and retimes no faster than a person) →
 //! [`looping`] (seamless repeats of looping clips) →
 //! [`transition`] (best frames by windowed posture distance, seed 003 eq. 1; blending) →
-//! [`contact`] (foot contacts, two-bone IK against ground penetration) →
+//! [`contact`] (foot contacts, two-bone IK against ground penetration) → [`footing`] (feet on
+//! the ground stand, the others clear it) →
 //! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
 //! [`plot`] draws contact sheets to look at the result; [`check`] (`figurine check`) judges
 //! it against real motion capture (penetration, floating, skating, joints bent backwards)
@@ -34,6 +35,7 @@ pub mod contact;
 pub mod defaults;
 pub mod effort;
 pub mod envelope;
+pub mod footing;
 pub mod graph_cuts;
 pub mod joint_limits;
 pub mod library;

@@ -6,7 +6,9 @@
 //! animation within them:
 //! - **gaits** (`pace`): whole cycles at a cadence within [`MAX_CADENCE`] of the clip's,
 //!   their stride the clip's (rescaled) travel, the path shrunk about its start where the
-//!   doodle asks more than that cadence, or [`HUMAN_ROOT_SPEED_M_S`] on average, covers;
+//!   doodle asks more than that cadence, or [`HUMAN_ROOT_SPEED_M_S`] on average, covers
+//!   (and the assembler shrinks it further where the cycle's bob and surge on top of that
+//!   pace would outrun [`HUMAN_ROOT_SPEED_M_S`]);
 //! - **any clip** ([`EffortClip::paced`]): no stretch of its time map moves the root faster
 //!   than a person ([`HUMAN_ROOT_SPEED_M_S`]); such stretches borrow time from the slow ones.
 
@@ -89,7 +91,7 @@ pub(super) fn pace(
 }
 
 /// `chunk` (starting at the origin) scaled about its start to at most `most` metres long.
-fn shrink(chunk: &Polyline, most: f32) -> Polyline {
+pub(super) fn shrink(chunk: &Polyline, most: f32) -> Polyline {
     let len = chunk.length();
     if len <= most || len <= 0.0 {
         return chunk.clone();
