@@ -18,7 +18,7 @@ use image::{Rgb, RgbImage};
 use super::detect::{tag_pattern, Detection, Detector, DetectorSettings, Family, Intrinsics};
 use super::eval::{place, render_video, scene, Setup};
 use super::pose::{camera_pose, intrinsics_from_fov, project, Calibration, DEFAULT_FOV_DEG};
-use super::print::{caption, rig_caption, tag_pdf, tag_png, Printed};
+use super::print::print_tags;
 use super::render::Faults;
 use super::rig::{BoxSize, Rig, DEFAULT_BOX_M};
 use super::tracker::Tracker;
@@ -233,7 +233,14 @@ pub fn run(args: &TrackArgs) -> Result<()> {
                 .as_deref()
                 .map(|r| rig_from_args(Some(r), *family, *id, *size, *box_size))
                 .transpose()?;
-            print_tag(*family, *id, *size, out, *px_per_cell, rig.as_ref())
+            Ok(print_tags(
+                *family,
+                *id,
+                *size,
+                out,
+                *px_per_cell,
+                rig.as_ref(),
+            )?)
         }
         Some(TrackCommand::Calibrate {
             video,
@@ -263,55 +270,6 @@ fn calibrate(video: &Path, family: Family, id: u32, out: &Path) -> Result<()> {
         cal.fx,
         cal.rms_px.unwrap_or(f64::NAN),
         views.len()
-    );
-    Ok(())
-}
-
-fn print_tag(
-    family: Family,
-    id: u32,
-    size: f64,
-    out: &Path,
-    px: u32,
-    rig: Option<&Rig>,
-) -> Result<()> {
-    if !(size.is_finite() && size > 0.0 && size < 1.0) {
-        return Err(TrackError::BadArgument(format!(
-            "--size {size}: the black square's edge in metres, e.g. 0.04"
-        ))
-        .into());
-    }
-    let tags: Vec<Printed> = match rig {
-        None => vec![(tag_pattern(family, id)?, caption(family, id, size))],
-        Some(rig) => rig
-            .faces
-            .iter()
-            .map(|f| {
-                Ok((
-                    tag_pattern(family, f.id)?,
-                    rig_caption(family, f.id, rig.tag_size, &f.name),
-                ))
-            })
-            .collect::<Result<_, TrackError>>()?,
-    };
-    let size = rig.map_or(size, |r| r.tag_size);
-    match out.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case("pdf") => tag_pdf(&tags, size, out)?,
-        _ => tag_png(&tags, size, px, out)?,
-    }
-    let what = match rig {
-        None => format!("id {id}"),
-        Some(r) => format!(
-            "{} tags for the rig:\n  {}",
-            r.faces.len(),
-            r.describe().join("\n  ")
-        ),
-    };
-    eprintln!(
-        "{}: {} {what}\nblack squares {:.1} mm; print at 100 % and measure them",
-        out.display(),
-        family.name(),
-        size * 1000.0
     );
     Ok(())
 }

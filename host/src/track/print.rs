@@ -8,7 +8,8 @@ use std::path::Path;
 
 use image::{Rgb, RgbImage};
 
-use super::detect::{Family, TagPattern};
+use super::detect::{tag_pattern, Family, TagPattern};
+use super::rig::Rig;
 use super::TrackError;
 use crate::raster::{draw_text, text_width};
 
@@ -226,6 +227,56 @@ pub fn tag_pdf(tags: &[Printed], size_m: f64, path: &Path) -> Result<(), TrackEr
             path: path.to_path_buf(),
             source,
         })
+}
+
+/// `figurine track print-tag`: tag `id` (or every tag of `rig`, each captioned with its face)
+/// as a PNG or a PDF (by `out`'s extension) at `size` metres, `px` PNG pixels per cell.
+pub fn print_tags(
+    family: Family,
+    id: u32,
+    size: f64,
+    out: &Path,
+    px: u32,
+    rig: Option<&Rig>,
+) -> Result<(), TrackError> {
+    if !(size.is_finite() && size > 0.0 && size < 1.0) {
+        return Err(TrackError::BadArgument(format!(
+            "--size {size}: the black square's edge in metres, e.g. 0.04"
+        )));
+    }
+    let tags: Vec<Printed> = match rig {
+        None => vec![(tag_pattern(family, id)?, caption(family, id, size))],
+        Some(rig) => rig
+            .faces
+            .iter()
+            .map(|f| {
+                Ok((
+                    tag_pattern(family, f.id)?,
+                    rig_caption(family, f.id, rig.tag_size, &f.name),
+                ))
+            })
+            .collect::<Result<_, TrackError>>()?,
+    };
+    let size = rig.map_or(size, |r| r.tag_size);
+    match out.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("pdf") => tag_pdf(&tags, size, out)?,
+        _ => tag_png(&tags, size, px, out)?,
+    }
+    let what = match rig {
+        None => format!("id {id}"),
+        Some(r) => format!(
+            "{} tags for the rig:\n  {}",
+            r.faces.len(),
+            r.describe().join("\n  ")
+        ),
+    };
+    eprintln!(
+        "{}: {} {what}\nblack squares {:.1} mm; print at 100 % and measure them",
+        out.display(),
+        family.name(),
+        size * 1000.0
+    );
+    Ok(())
 }
 
 #[cfg(test)]
