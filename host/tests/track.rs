@@ -2,8 +2,7 @@
 //! to MP4, tracked, and compared with the poses that were drawn; the printed tag; and the
 //! errors bad input gets.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use figurine_host::poselog::{PoseLog, PoseSample};
 use figurine_host::synth::Action;
@@ -11,65 +10,9 @@ use figurine_host::track::bench::run_gesture;
 use figurine_host::track::eval::{summarize, Setup, Tracking};
 use glam::{DQuat, DVec3};
 
-fn figurine(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_figurine"))
-        .args(args)
-        .output()
-        .expect("run figurine")
-}
+mod track_common;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("figurine-track-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Runs `figurine ARGS` and asserts it succeeded (showing its stderr if not).
-fn succeeds(args: &[&str]) -> Output {
-    let out = figurine(args);
-    assert!(
-        out.status.success(),
-        "figurine {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-/// Writes `log` as `dir/NAME.csv` and renders it, already in the camera's frame
-/// (`track render --as-is`, plus `extra`), to `dir/NAME.mp4`; returns the video's path.
-fn render_as_is(dir: &Path, name: &str, log: &PoseLog, extra: &[&str]) -> PathBuf {
-    let path = dir.join(format!("{name}.csv"));
-    log.write_path(&path).unwrap();
-    let video = dir.join(format!("{name}.mp4"));
-    let mut args = vec![
-        "track",
-        "render",
-        "--log",
-        s(&path),
-        "--out",
-        s(&video),
-        "--as-is",
-    ];
-    args.extend_from_slice(extra);
-    succeeds(&args);
-    video
-}
-
-/// A failed run that explains itself and did not panic.
-fn fails_saying(out: &Output, words: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "should fail: {err}");
-    assert!(!err.contains("panicked"), "panicked: {err}");
-    for w in words {
-        assert!(err.contains(w), "`{w}` not in: {err}");
-    }
-}
+use track_common::{fails_saying, figurine, render_as_is, s, scratch, succeeds};
 
 #[test]
 fn a_gesture_is_tracked_within_goals_and_reads_as_the_same_action() {

@@ -16,6 +16,7 @@ use super::eval::{
     compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
     FrameError, FrameTruth, Noise, Setup, Summary, Tracking,
 };
+use super::rig::{BoxSize, DEFAULT_BOX_M};
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
 
@@ -44,6 +45,16 @@ pub struct BenchArgs {
     /// comparing the two).
     #[arg(long)]
     pub whole_frames: bool,
+    /// Track a rig of four tags around the figurine instead of one on its chest: `box`, a
+    /// box with tags 0, 1, 2, 3 on its front, left, back and right sides.
+    #[arg(long, value_parser = ["box"])]
+    pub rig: Option<String>,
+    /// The box rig's width (across, the figurine's X), metres.
+    #[arg(long, default_value_t = DEFAULT_BOX_M)]
+    pub box_width: f64,
+    /// The box rig's depth (front to back, its Z), metres.
+    #[arg(long, default_value_t = DEFAULT_BOX_M)]
+    pub box_depth: f64,
     /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
@@ -157,8 +168,8 @@ pub fn run_gesture(
 /// Writes what each frame of a kept video showed, for `--reuse`.
 fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) -> Result<()> {
     let mut text = format!(
-        "# tag {} m at {} m, seed {}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
-        setup.tag_size, setup.distance, setup.seed
+        "{}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
+        truths_head(setup)
     );
     for f in truths {
         let p = &f.pose;
@@ -187,10 +198,7 @@ fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>>
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut lines = text.lines();
-    let head = format!(
-        "# tag {} m at {} m, seed {}",
-        setup.tag_size, setup.distance, setup.seed
-    );
+    let head = truths_head(setup);
     anyhow::ensure!(lines.next() == Some(head.as_str()), "another setup");
     lines.next();
     lines
@@ -213,6 +221,17 @@ fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>>
             })
         })
         .collect()
+}
+
+/// The first line of a kept video's truths: the setup it was drawn with.
+fn truths_head(setup: &Setup) -> String {
+    let rig = setup.rig_box.map_or(String::new(), |b| {
+        format!(", box {} × {} m", b.width, b.depth)
+    });
+    format!(
+        "# tag {} m at {} m, seed {}{rig}",
+        setup.tag_size, setup.distance, setup.seed
+    )
 }
 
 fn row(out: &mut String, label: &str, s: &Summary) {
@@ -359,12 +378,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             tmp.clone()
         }
     };
+    let rig_box = args.rig.as_ref().map(|_| BoxSize {
+        width: args.box_width,
+        depth: args.box_depth,
+    });
+    if let Some(b) = rig_box {
+        let rig =
+            super::rig::Rig::checked_box(Family::Tag36h11, 0, args.tag_size, b.width, b.depth)?;
+        eprintln!("a box rig of {} × {} m:", b.width, b.depth);
+        for line in rig.describe() {
+            eprintln!("  {line}");
+        }
+    }
     let mut runs = Vec::new();
     for (di, &distance) in args.distances.iter().enumerate() {
         let setup = Setup {
             distance,
             tag_size: args.tag_size,
             seed: args.seed.wrapping_add(di as u64),
+            rig_box,
             ..Setup::default()
         };
         for g in 0..args.gestures {

@@ -183,7 +183,7 @@ pub fn corners_from_video(
         return Err(TrackError::NoTag {
             source_name: path.display().to_string(),
             family: family.name(),
-            id,
+            ids: id.to_string(),
             frames,
         });
     }

@@ -18,8 +18,9 @@ use image::{Rgb, RgbImage};
 use super::detect::{tag_pattern, Detection, Detector, DetectorSettings, Family, Intrinsics};
 use super::eval::{place, render_video, scene, Setup};
 use super::pose::{camera_pose, intrinsics_from_fov, project, Calibration, DEFAULT_FOV_DEG};
-use super::print::{caption, tag_pdf, tag_png};
+use super::print::print_tags;
 use super::render::Faults;
+use super::rig::{BoxSize, Rig, DEFAULT_BOX_M};
 use super::tracker::Tracker;
 use super::video::{FrameReader, Source};
 use super::TrackError;
@@ -81,6 +82,44 @@ pub struct RunArgs {
     /// figurine from jittering by a degree or two.
     #[arg(long)]
     pub raw: bool,
+    /// Track a rig of tags around the figurine instead of one on its chest: `box` (tags
+    /// `--tag-id` … `--tag-id`+3 on the front, left, back and right sides of a box, see
+    /// `--box-width`, `--box-depth`) or a rig file (JSON: each tag's id, centre, normal and up
+    /// in the figurine frame).
+    #[arg(long)]
+    pub rig: Option<String>,
+    /// The box's size with `--rig box`.
+    #[command(flatten)]
+    pub box_size: BoxArgs,
+}
+
+/// The size of a box rig.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct BoxArgs {
+    /// The box rig's width (across, the figurine's X: its front and back faces), metres.
+    #[arg(long, default_value_t = DEFAULT_BOX_M)]
+    pub box_width: f64,
+    /// The box rig's depth (front to back, its Z: its left and right faces), metres.
+    #[arg(long, default_value_t = DEFAULT_BOX_M)]
+    pub box_depth: f64,
+}
+
+/// The rig `--rig` names (`None`: one tag `id` on the chest), checked against the family.
+pub fn rig_from_args(
+    rig: Option<&str>,
+    family: Family,
+    id: u32,
+    tag_size: f64,
+    size: BoxArgs,
+) -> Result<Rig, TrackError> {
+    match rig {
+        None => {
+            tag_pattern(family, id)?;
+            Ok(Rig::single(id, tag_size))
+        }
+        Some("box") => Rig::checked_box(family, id, tag_size, size.box_width, size.box_depth),
+        Some(path) => Rig::read(Path::new(path), family, tag_size),
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -102,6 +141,12 @@ enum TrackCommand {
         /// PNG pixels per cell (the file's density keeps the printed size whatever this is).
         #[arg(long, default_value_t = 40)]
         px_per_cell: u32,
+        /// Print every tag of a rig (`box`, or a rig file), each captioned with its face,
+        /// ids from `--id` on.
+        #[arg(long)]
+        rig: Option<String>,
+        #[command(flatten)]
+        box_size: BoxArgs,
     },
     /// Measure the camera's focal length from a video of the tag turned through different
     /// tilts (10+ frames tilted 15° or more), and write CAL.json for `--calibration`.
@@ -160,6 +205,12 @@ pub struct RenderArgs {
     /// No blur, noise, light changes or occlusion.
     #[arg(long)]
     clean: bool,
+    /// Draw a box rig around the figurine (`box`: tags `--tag-id` … +3 on its front, left,
+    /// back and right) instead of one tag on its chest.
+    #[arg(long, value_parser = ["box"])]
+    rig: Option<String>,
+    #[command(flatten)]
+    box_size: BoxArgs,
     /// Take the log as it is, already in the camera's world frame (origin at the camera, +Y
     /// up, +Z toward the camera: a tracked log), instead of moving it in front of the camera.
     #[arg(long, conflicts_with = "distance")]
@@ -175,7 +226,22 @@ pub fn run(args: &TrackArgs) -> Result<()> {
             family,
             out,
             px_per_cell,
-        }) => print_tag(*family, *id, *size, out, *px_per_cell),
+            rig,
+            box_size,
+        }) => {
+            let rig = rig
+                .as_deref()
+                .map(|r| rig_from_args(Some(r), *family, *id, *size, *box_size))
+                .transpose()?;
+            Ok(print_tags(
+                *family,
+                *id,
+                *size,
+                out,
+                *px_per_cell,
+                rig.as_ref(),
+            )?)
+        }
         Some(TrackCommand::Calibrate {
             video,
             tag_id,
@@ -208,28 +274,6 @@ fn calibrate(video: &Path, family: Family, id: u32, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn print_tag(family: Family, id: u32, size: f64, out: &Path, px: u32) -> Result<()> {
-    if !(size.is_finite() && size > 0.0 && size < 1.0) {
-        return Err(TrackError::BadArgument(format!(
-            "--size {size}: the black square's edge in metres, e.g. 0.04"
-        ))
-        .into());
-    }
-    let pattern = tag_pattern(family, id)?;
-    let lines = caption(family, id, size);
-    match out.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case("pdf") => tag_pdf(&pattern, &lines, size, out)?,
-        _ => tag_png(&pattern, &lines, size, px, out)?,
-    }
-    eprintln!(
-        "{}: {} id {id}, black square {:.1} mm; print at 100 % and measure it",
-        out.display(),
-        family.name(),
-        size * 1000.0
-    );
-    Ok(())
-}
-
 fn render(a: &RenderArgs) -> Result<()> {
     if !(a.distance > 0.1 && a.fov > 1.0 && a.fov < 170.0 && a.fps > 0.0 && a.tag_size > 0.0) {
         return Err(TrackError::BadArgument(
@@ -255,6 +299,10 @@ fn render(a: &RenderArgs) -> Result<()> {
             Faults::default()
         },
         seed: a.seed,
+        rig_box: a.rig.as_ref().map(|_| BoxSize {
+            width: a.box_size.box_width,
+            depth: a.box_size.box_depth,
+        }),
         ..Setup::default()
     };
     let placed = if a.as_is {
@@ -320,8 +368,19 @@ pub fn track(args: &RunArgs) -> Result<()> {
         ))
         .into());
     }
-    let pattern = tag_pattern(args.family, args.tag_id)?;
-    drop(pattern);
+    let rig = rig_from_args(
+        args.rig.as_deref(),
+        args.family,
+        args.tag_id,
+        args.tag_size,
+        args.box_size,
+    )?;
+    let ids = rig
+        .faces
+        .iter()
+        .map(|f| f.id.to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
     let source = match (&args.video, &args.camera) {
         (Some(v), _) => Source::File(v.clone()),
         (None, Some(c)) => {
@@ -352,8 +411,14 @@ pub fn track(args: &RunArgs) -> Result<()> {
         ..DetectorSettings::default()
     };
     let detector = Detector::new(args.family, settings)?;
-    let mut tracker =
-        Tracker::new(detector, args.tag_id, args.tag_size, k).with_smoothing(!args.raw);
+    if rig.faces.len() > 1 {
+        eprintln!("{name}: following a rig of {} tags:", rig.faces.len());
+        for line in rig.describe() {
+            eprintln!("  {line}");
+        }
+    }
+    let tag_size = rig.tag_size;
+    let mut tracker = Tracker::with_rig(detector, rig, k).with_smoothing(!args.raw);
     let mut sink = Sink::open(args.out.as_deref())?;
     let mut overlay_done = args.overlay.is_none();
     let mut frames = 0u64;
@@ -370,16 +435,22 @@ pub fn track(args: &RunArgs) -> Result<()> {
             samples += 1;
         }
         if !overlay_done {
-            if let (Some(path), Some(d)) = (&args.overlay, &result.detection) {
-                overlay(&frame, d, result.pose.as_ref(), args.tag_size, &k, path)?;
+            if let (Some(path), false) = (&args.overlay, result.detections.is_empty()) {
+                overlay(
+                    &frame,
+                    &result.detections,
+                    result.pose.as_ref(),
+                    tag_size,
+                    &k,
+                    path,
+                )?;
                 overlay_done = true;
             }
         }
         if live && frames.is_multiple_of(150) && samples == 0 {
             eprintln!(
-                "{name}: no {} tag {} seen yet ({frames} frames)",
+                "{name}: no {} tag {ids} seen yet ({frames} frames)",
                 args.family.name(),
-                args.tag_id
             );
         }
     }
@@ -388,7 +459,7 @@ pub fn track(args: &RunArgs) -> Result<()> {
         return Err(TrackError::NoTag {
             source_name: name,
             family: args.family.name(),
-            id: args.tag_id,
+            ids,
             frames,
         }
         .into());
@@ -453,11 +524,12 @@ impl Sink {
     }
 }
 
-/// Writes `frame` with the detected corners (red, the first one larger) and the figurine's
-/// axes from the tag centre (+X left red, +Y up green, +Z front blue, one tag edge long).
+/// Writes `frame` with the detected corners of every tag (red, the first one larger) and the
+/// figurine's axes from its origin (+X left red, +Y up green, +Z front blue, 1.5 tag edges
+/// long).
 pub fn overlay(
     frame: &super::detect::GrayFrame,
-    d: &Detection,
+    found: &[Detection],
     pose: Option<&super::detect::CameraPose>,
     tag_size: f64,
     k: &Intrinsics,
@@ -470,16 +542,18 @@ pub fn overlay(
     });
     let pt = |p: [f64; 2]| (p[0].round() as i64, p[1].round() as i64);
     let red = Rgb([255, 40, 40]);
-    for i in 0..4 {
-        line(
-            &mut img,
-            pt(d.corners[i]),
-            pt(d.corners[(i + 1) % 4]),
-            Rgb([255, 200, 0]),
-        );
-        let (x, y) = pt(d.corners[i]);
-        let r = if i == 0 { 3 } else { 1 };
-        fill_rect(&mut img, x - r, y - r, 2 * r + 1, 2 * r + 1, red);
+    for d in found {
+        for i in 0..4 {
+            line(
+                &mut img,
+                pt(d.corners[i]),
+                pt(d.corners[(i + 1) % 4]),
+                Rgb([255, 200, 0]),
+            );
+            let (x, y) = pt(d.corners[i]);
+            let r = if i == 0 { 3 } else { 1 };
+            fill_rect(&mut img, x - r, y - r, 2 * r + 1, 2 * r + 1, red);
+        }
     }
     if let Some(pose) = pose {
         let (p, q) = super::pose::figurine_pose(pose);

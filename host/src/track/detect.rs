@@ -190,13 +190,31 @@ pub struct CameraPose {
 impl CameraPose {
     /// The rotation as a unit quaternion (tag→camera).
     pub fn quat(&self) -> glam::DQuat {
+        glam::DQuat::from_mat3(&self.matrix()).normalize()
+    }
+
+    /// The rotation as a matrix (tag→camera).
+    pub fn matrix(&self) -> glam::DMat3 {
         let r = self.rotation;
-        glam::DQuat::from_mat3(&glam::DMat3::from_cols(
+        glam::DMat3::from_cols(
             glam::DVec3::new(r[0][0], r[1][0], r[2][0]),
             glam::DVec3::new(r[0][1], r[1][1], r[2][1]),
             glam::DVec3::new(r[0][2], r[1][2], r[2][2]),
-        ))
-        .normalize()
+        )
+    }
+
+    /// A pose from a rotation matrix, a translation (metres) and its RMS corner error
+    /// (pixels).
+    pub fn from_parts(rotation: glam::DMat3, translation: glam::DVec3, error: f64) -> Self {
+        Self {
+            rotation: [
+                rotation.row(0).to_array(),
+                rotation.row(1).to_array(),
+                rotation.row(2).to_array(),
+            ],
+            translation: translation.to_array(),
+            error,
+        }
     }
 }
 

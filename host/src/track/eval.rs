@@ -8,9 +8,11 @@ use std::path::Path;
 
 use glam::{DQuat, DVec3};
 
+use super::body::Body;
 use super::detect::{tag_pattern, Detector, DetectorSettings, Family};
 use super::pose::{angle_between_deg, intrinsics_from_fov};
 use super::render::{Faults, Scene};
+use super::rig::{BoxSize, Rig};
 use super::tracker::{track_reader, Tracker};
 use super::video::{FrameReader, Mp4Writer, Source};
 use super::TrackError;
@@ -35,6 +37,9 @@ pub struct Setup {
     pub faults: Faults,
     /// Seed of the picture's noise, light and occlusion.
     pub seed: u64,
+    /// A box rig of four tags (ids from the tag id on: front, left, back, right) instead of
+    /// one tag on the chest.
+    pub rig_box: Option<BoxSize>,
 }
 
 impl Default for Setup {
@@ -48,6 +53,7 @@ impl Default for Setup {
             distance: 0.7,
             faults: Faults::default(),
             seed: 0,
+            rig_box: None,
         }
     }
 }
@@ -123,8 +129,9 @@ pub struct FrameTruth {
     pub pose: PoseSample,
     /// The figurine's speed, m/s.
     pub speed: f64,
-    /// Whether the tag was out of sight: a finger covered part of it, or it was turned more
-    /// than [`MAX_VIEW_DEG`] from the camera (the back of a turn or spin).
+    /// Whether every tag was out of sight: a finger covered part of it, or it was turned more
+    /// than [`MAX_VIEW_DEG`] from the camera (for one tag on the chest, the back of a turn or
+    /// spin).
     pub hidden: bool,
 }
 
@@ -139,14 +146,50 @@ pub fn facing_deg(pose: &PoseSample) -> f64 {
     front.angle_between(to_camera).to_degrees()
 }
 
-/// The scene of `setup` with tag `id` of `family`.
+/// How many of the body's tags face the camera within [`MAX_VIEW_DEG`] at `pose`.
+pub fn tags_in_sight(body: &Body, pose: &PoseSample) -> usize {
+    let (pos, q) = (DVec3::from_array(pose.pos), quat(pose));
+    body.panels
+        .iter()
+        .filter(|p| p.tag.is_some())
+        .filter(|p| {
+            let (centre, pq) = body.panel_pose(p, pos, q);
+            let angle = (pq * DVec3::Z).angle_between(-centre).to_degrees();
+            angle <= MAX_VIEW_DEG
+        })
+        .count()
+}
+
+/// The rig of `setup`: its box, or tag `id` alone on the chest.
+pub fn rig(setup: &Setup, family: Family, id: u32) -> Result<Rig, TrackError> {
+    match setup.rig_box {
+        Some(b) => Rig::checked_box(family, id, setup.tag_size, b.width, b.depth),
+        None => {
+            tag_pattern(family, id)?;
+            Ok(Rig::single(id, setup.tag_size))
+        }
+    }
+}
+
+/// The scene of `setup` with tag `id` of `family` on the chest, or its box rig from `id` on.
 pub fn scene(setup: &Setup, family: Family, id: u32) -> Result<Scene, TrackError> {
+    let body = match setup.rig_box {
+        Some(b) => {
+            let rig = rig(setup, family, id)?;
+            let patterns = rig
+                .faces
+                .iter()
+                .map(|f| tag_pattern(family, f.id))
+                .collect::<Result<_, _>>()?;
+            Body::rig_box(&rig, patterns, b.width, b.depth)
+        }
+        None => Body::chest(tag_pattern(family, id)?, setup.tag_size),
+    };
     Ok(Scene {
         width: setup.width,
         height: setup.height,
         intrinsics: intrinsics_from_fov(setup.width, setup.height, setup.fov_deg),
-        tag: tag_pattern(family, id)?,
-        tag_size: setup.tag_size,
+        body,
         faults: setup.faults,
         seed: setup.seed,
     })
@@ -186,7 +229,7 @@ pub fn render_video(
             t: tv,
             pose,
             speed: if speed.is_finite() { speed } else { 0.0 },
-            hidden: r.occluded || facing_deg(&pose) > MAX_VIEW_DEG,
+            hidden: tags_in_sight(&scene.body, &pose) <= usize::from(r.occluded),
         });
     }
     out.finish()?;
@@ -222,7 +265,7 @@ pub fn track_video(
     let mut reader = FrameReader::open(Source::File(path.to_path_buf()))?;
     let k = intrinsics_from_fov(reader.width(), reader.height(), setup.fov_deg);
     let detector = Detector::new(family, DetectorSettings::default())?;
-    let mut tracker = Tracker::new(detector, id, setup.tag_size, k)
+    let mut tracker = Tracker::with_rig(detector, rig(setup, family, id)?, k)
         .with_smoothing(how.smooth)
         .with_region_search(how.region_search);
     track_reader(&mut reader, &mut tracker, |_| Ok(()))

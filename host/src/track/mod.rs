@@ -9,14 +9,17 @@
 //! a moving figurine and [`eval`] compares what was tracked with the truth.
 
 pub mod bench;
+pub mod body;
 pub mod calibrate;
 pub mod cli;
 pub mod detect;
 pub mod eval;
+pub mod fuse;
 pub mod pnp;
 pub mod pose;
 pub mod print;
 pub mod render;
+pub mod rig;
 pub mod smooth;
 pub mod tracker;
 pub mod video;
@@ -46,7 +49,7 @@ pub enum TrackError {
     },
     /// The tag was never seen.
     #[error(
-        "{source_name}: no {family} tag {id} in any of {frames} frames (is the tag in view, \
+        "{source_name}: no {family} tag {ids} in any of {frames} frames (is the tag in view, \
          well lit, of this family and id? a tag under ~15 px across is too small)"
     )]
     NoTag {
@@ -54,8 +57,8 @@ pub enum TrackError {
         source_name: String,
         /// The family looked for.
         family: &'static str,
-        /// The id looked for.
-        id: u32,
+        /// The ids looked for ("0", or a rig's "0, 1, 2, 3").
+        ids: String,
         /// Frames searched.
         frames: u64,
     },
@@ -77,6 +80,9 @@ pub enum TrackError {
         /// How many ids it has.
         count: u32,
     },
+    /// A rig description that cannot be tracked.
+    #[error("bad rig: {0}")]
+    BadRig(String),
     /// An argument makes no sense.
     #[error("{0}")]
     BadArgument(String),

@@ -94,31 +94,35 @@ fn pose_from_homography(h: DMat3) -> Option<(DQuat, DVec3)> {
     Some((DQuat::from_mat3(&r).normalize(), t))
 }
 
-/// Reprojection residuals (pixels) of the corners under pose (q, t).
-fn residuals(q: DQuat, t: DVec3, obj: &[DVec3; 4], px: &[DVec2; 4], k: &Intrinsics) -> [f64; 8] {
-    let mut r = [0.0; 8];
-    for i in 0..4 {
-        let p = q * obj[i] + t;
-        let z = p.z.max(1e-6);
-        r[2 * i] = k.cx + k.fx * p.x / z - px[i].x;
-        r[2 * i + 1] = k.cy + k.fy * p.y / z - px[i].y;
+/// Reprojection residuals (pixels) of the points under pose (q, t): x and y per point.
+fn residuals(q: DQuat, t: DVec3, obj: &[DVec3], px: &[DVec2], k: &Intrinsics) -> Vec<f64> {
+    let mut r = Vec::with_capacity(2 * obj.len());
+    for (o, p) in obj.iter().zip(px) {
+        let c = q * *o + t;
+        let z = c.z.max(1e-6);
+        r.push(k.cx + k.fx * c.x / z - p.x);
+        r.push(k.cy + k.fy * c.y / z - p.y);
     }
     r
 }
 
-fn rms(r: &[f64; 8]) -> f64 {
-    (r.iter().map(|v| v * v).sum::<f64>() / 4.0).sqrt()
+/// RMS reprojection error per point, pixels.
+fn rms(r: &[f64]) -> f64 {
+    (r.iter().map(|v| v * v).sum::<f64>() / (r.len() / 2).max(1) as f64).sqrt()
 }
 
-/// Levenberg–Marquardt on the pose (a rotation-vector step on the left, and the translation);
-/// returns the refined pose and its RMS corner error in pixels.
-fn refine(
+/// Levenberg–Marquardt on a pose (a rotation-vector step on the left, and the translation)
+/// that takes object points `obj` (metres) to pixels `px`; returns the refined pose and its
+/// RMS point error in pixels. Four corners of one tag, or the corners of every tag of a rig
+/// in sight (points on several planes: no mirror pose to confuse).
+pub fn refine(
     mut q: DQuat,
     mut t: DVec3,
-    obj: &[DVec3; 4],
-    px: &[DVec2; 4],
+    obj: &[DVec3],
+    px: &[DVec2],
     k: &Intrinsics,
 ) -> (DQuat, DVec3, f64) {
+    let n = 2 * obj.len().min(px.len());
     let mut r = residuals(q, t, obj, px, k);
     let mut cost = rms(&r);
     let mut mu = 1e-3;
@@ -132,25 +136,23 @@ fn refine(
         ((dq * q).normalize(), t + DVec3::new(d[3], d[4], d[5]))
     };
     for _ in 0..30 {
-        // Numerical Jacobian: 6 columns of 8 residuals.
-        let mut jac = [[0.0; 8]; 6];
+        // Numerical Jacobian: 6 columns of n residuals.
+        let mut jac: [Vec<f64>; 6] = Default::default();
         for (j, col) in jac.iter_mut().enumerate() {
             let step = if j < 3 { 1e-6 } else { 1e-7 };
             let mut d = [0.0; 6];
             d[j] = step;
             let (q1, t1) = apply(q, t, &d);
             let r1 = residuals(q1, t1, obj, px, k);
-            for i in 0..8 {
-                col[i] = (r1[i] - r[i]) / step;
-            }
+            *col = (0..n).map(|i| (r1[i] - r[i]) / step).collect();
         }
         let mut jtj = [[0.0; 6]; 6];
         let mut jtr = [0.0; 6];
         for a in 0..6 {
             for b in 0..6 {
-                jtj[a][b] = (0..8).map(|i| jac[a][i] * jac[b][i]).sum();
+                jtj[a][b] = (0..n).map(|i| jac[a][i] * jac[b][i]).sum();
             }
-            jtr[a] = -(0..8).map(|i| jac[a][i] * r[i]).sum::<f64>();
+            jtr[a] = -(0..n).map(|i| jac[a][i] * r[i]).sum::<f64>();
         }
         let mut improved = false;
         for _ in 0..8 {
@@ -226,16 +228,7 @@ pub fn solve_pose(
     if !(err.is_finite() && t.is_finite()) {
         return None;
     }
-    let m = DMat3::from_quat(q);
-    Some(CameraPose {
-        rotation: [
-            m.row(0).to_array(),
-            m.row(1).to_array(),
-            m.row(2).to_array(),
-        ],
-        translation: t.to_array(),
-        error: err,
-    })
+    Some(CameraPose::from_parts(DMat3::from_quat(q), t, err))
 }
 
 #[cfg(test)]

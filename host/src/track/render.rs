@@ -1,27 +1,21 @@
-//! A software rasteriser for test videos: a printed tag on a card on a figurine's chest, seen
-//! by a pinhole camera at 640×480 in grey, with the faults of a webcam — motion blur over the
-//! exposure, defocus, sensor noise, light that drifts and a finger that sometimes covers part
-//! of the card. Seeded: the same scene and seed give the same frames.
+//! A software rasteriser for test videos: a figurine — a printed tag on a card on its chest,
+//! or a box with a tag on each side ([`super::body`]) — seen by a pinhole camera at 640×480
+//! in grey, with the faults of a webcam — motion blur over the exposure, defocus, sensor
+//! noise, light that drifts and a finger that sometimes covers part of a card. Seeded: the
+//! same scene and seed give the same frames.
 //!
-//! The card lies in the tag's plane. Plane coordinates (u, v) are metres from the tag's
-//! centre, u to the printed right and v down the printed page (the detector's tag frame), so
-//! a pixel is coloured by sending it back through the plane's homography.
+//! Each panel of the body is a plane; a pixel is coloured by sending it back through each
+//! plane's homography to the panel's coordinates (metres, u right and v down as seen from
+//! outside), and the nearest panel there wins.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 
-use super::detect::{GrayFrame, Intrinsics, TagPattern};
+use super::body::{Body, Panel};
+use super::detect::{GrayFrame, Intrinsics};
 use super::pose::camera_pose;
 use crate::poselog::PoseSample;
 use crate::synth::rng::SynthRng;
 
-/// Grey level of the printed white (paper under room light).
-const PAPER: f64 = 215.0;
-/// Grey level of the printed black.
-const INK: f64 = 30.0;
-/// Grey level of the figurine's body around the card.
-const BODY: f64 = 105.0;
-/// Grey level of the figurine's back (the card faces away).
-const BACK: f64 = 85.0;
 /// Grey level of the finger that occludes.
 const SKIN: f64 = 160.0;
 
@@ -54,7 +48,7 @@ impl Default for Faults {
     }
 }
 
-/// What is in view: the tag, the card and body around it, the camera.
+/// What is in view: the figurine's body with its tags, the camera.
 #[derive(Debug, Clone)]
 pub struct Scene {
     /// Frame width, pixels.
@@ -63,10 +57,8 @@ pub struct Scene {
     pub height: usize,
     /// The camera.
     pub intrinsics: Intrinsics,
-    /// The printed pattern.
-    pub tag: TagPattern,
-    /// Edge of the tag's black border square, metres.
-    pub tag_size: f64,
+    /// The figurine: its panels and the tags printed on them.
+    pub body: Body,
     /// The webcam's faults.
     pub faults: Faults,
     /// Seed of the noise, light and occlusion.
@@ -78,22 +70,27 @@ pub struct Scene {
 pub struct Rendered {
     /// The picture.
     pub frame: GrayFrame,
-    /// Whether a finger covered part of the tag in this frame (it may be lost then).
+    /// Whether a finger covered part of a tag in this frame (it may be lost then): the one
+    /// most turned toward the camera.
     pub occluded: bool,
 }
 
-/// A plane's homography from (u, v, 1) in metres to pixels, and which side faces the camera.
+/// A panel's homography from (u, v, 1) in metres to pixels, which side faces the camera, and
+/// its depth along the optical axis as a function of (u, v).
 struct PlaneView {
+    panel: usize,
     inv: DMat3,
     front: bool,
+    /// Depth (metres) = `depth[0] u + depth[1] v + depth[2]`.
+    depth: [f64; 3],
+    /// How squarely it faces the camera: the cosine between its normal and the line of
+    /// sight to its centre (negative: its back).
+    facing: f64,
 }
 
 impl PlaneView {
-    fn new(k: &Intrinsics, pose: &PoseSample) -> Option<Self> {
-        let (r, t) = camera_pose(
-            DVec3::from_array(pose.pos),
-            glam::DQuat::from_xyzw(pose.quat[1], pose.quat[2], pose.quat[3], pose.quat[0]),
-        );
+    fn new(k: &Intrinsics, panel: usize, pos: DVec3, q: DQuat) -> Option<Self> {
+        let (r, t) = camera_pose(pos, q);
         if t.z <= 0.05 {
             return None;
         }
@@ -108,9 +105,13 @@ impl PlaneView {
         }
         // The tag's z points into the card: the printed side faces the camera when z points
         // away from it, along the line of sight.
+        let facing = r.z_axis.dot(t) / t.length();
         Some(Self {
+            panel,
             inv: h.inverse(),
-            front: r.z_axis.dot(t) > 0.0,
+            front: facing > 0.0,
+            depth: [r.x_axis.z, r.y_axis.z, t.z],
+            facing,
         })
     }
 
@@ -122,41 +123,50 @@ impl PlaneView {
 }
 
 impl Scene {
-    /// Cell edge of the printed pattern, metres.
-    fn cell(&self) -> f64 {
-        self.tag_size / self.tag.border_width.max(1) as f64
+    /// The views of the body's panels at the pose (the backs of a closed box's faces left
+    /// out).
+    fn views(&self, pose: &PoseSample) -> Vec<PlaneView> {
+        let pos = DVec3::from_array(pose.pos);
+        let q = DQuat::from_xyzw(pose.quat[1], pose.quat[2], pose.quat[3], pose.quat[0]);
+        self.body
+            .panels
+            .iter()
+            .enumerate()
+            .filter_map(|(i, panel)| {
+                let (p, pq) = self.body.panel_pose(panel, pos, q);
+                PlaneView::new(&self.intrinsics, i, p, pq)
+            })
+            .filter(|v| v.front || self.body.panels[v.panel].two_sided)
+            .collect()
     }
 
-    /// The plane's half-extents: the body is 12 cm wide and reaches 6 cm above the card's top
-    /// and 12 cm below its bottom (a torso), the card 1.5 cells beyond the pattern.
-    fn extents(&self) -> (f64, f64, f64, f64) {
-        let half_card = self.cell() * (self.tag.width as f64 / 2.0 + 1.5);
-        (half_card, 0.06, half_card + 0.06, half_card + 0.12)
+    /// Grey level at pixel (x, y) of the nearest panel there, `None` where no panel is.
+    fn sample(&self, views: &[PlaneView], x: f64, y: f64) -> Option<f64> {
+        let mut best: Option<(f64, f64)> = None;
+        for v in views {
+            let Some((u, vv)) = v.plane_at(x, y) else {
+                continue;
+            };
+            let Some(g) = self.body.shade(&self.body.panels[v.panel], u, vv, v.front) else {
+                continue;
+            };
+            let z = v.depth[0] * u + v.depth[1] * vv + v.depth[2];
+            if best.is_none_or(|(bz, _)| z < bz) {
+                best = Some((z, g));
+            }
+        }
+        best.map(|(_, g)| g)
     }
 
-    /// Grey level of the plane at (u, v), `None` off the body.
-    fn shade(&self, u: f64, v: f64, front: bool) -> Option<f64> {
-        let (half_card, half_body, top, bottom) = self.extents();
-        if u.abs() > half_body || v < -top || v > bottom {
-            return None;
-        }
-        if !front {
-            return Some(BACK);
-        }
-        if u.abs() > half_card || v.abs() > half_card {
-            return Some(BODY);
-        }
-        let cell = self.cell();
-        let half_pattern = cell * self.tag.width as f64 / 2.0;
-        let cx = ((u + half_pattern) / cell).floor();
-        let cy = ((v + half_pattern) / cell).floor();
-        if cx < 0.0 || cy < 0.0 {
-            return Some(PAPER);
-        }
-        Some(if self.tag.is_black(cx as usize, cy as usize) {
-            INK
-        } else {
-            PAPER
+    /// Whether pixel (x, y) lies on or near (within `margin` metres of) a tag's card, where
+    /// edges need fine sampling.
+    fn near_card(&self, views: &[PlaneView], x: f64, y: f64, margin: f64) -> bool {
+        views.iter().any(|v| {
+            let panel = &self.body.panels[v.panel];
+            panel.tag.is_some()
+                && v.plane_at(x, y).is_some_and(|(u, vv)| {
+                    u.abs().max(vv.abs()) <= self.body.half_card(panel) + margin
+                })
         })
     }
 
@@ -202,10 +212,10 @@ impl Scene {
         img.resize(w * h, 128.0);
         // Motion blur: the exposure is averaged over a few instants.
         const SUB: usize = 4;
-        let views: Vec<Option<PlaneView>> = (0..SUB)
+        let views: Vec<Vec<PlaneView>> = (0..SUB)
             .map(|i| {
                 let dt = self.faults.exposure_s * ((i as f64 + 0.5) / SUB as f64 - 0.5);
-                pose_at(t + dt).and_then(|p| PlaneView::new(&self.intrinsics, &p))
+                pose_at(t + dt).map_or_else(Vec::new, |p| self.views(&p))
             })
             .collect();
         let bbox = self.bbox(&views, t, &pose_at);
@@ -225,29 +235,20 @@ impl Scene {
                         .unwrap_or([(0.5, 0.5); 4])
                 })
                 .collect();
-            // Only the card needs the fine sampling: away from it (by `margin` in the plane,
+            // Only the cards need the fine sampling: away from them (by `margin` in the plane,
             // tens of pixels) one sample per sub-exposure draws the body and the room.
-            let (half_card, ..) = self.extents();
             let margin = 0.01;
-            let mid = views.get(views.len() / 2).and_then(Option::as_ref);
+            let mid = &views[views.len() / 2];
             for y in y0..y1 {
                 for x in x0..x1 {
-                    let coarse = mid
-                        .and_then(|v| v.plane_at(x as f64 + 0.5, y as f64 + 0.5))
-                        .is_none_or(|(u, v)| u.abs().max(v.abs()) > half_card + margin);
+                    let coarse = !self.near_card(mid, x as f64 + 0.5, y as f64 + 0.5, margin);
                     let mut sum = 0.0;
                     let mut n = 0.0;
                     for (view, offs) in views.iter().zip(&offsets) {
                         let offs: &[(f64, f64)] = if coarse { &offs[..1] } else { offs };
                         for &(sx, sy) in offs {
                             let (px, py) = (x as f64 + sx, y as f64 + sy);
-                            let g = view
-                                .as_ref()
-                                .and_then(|v| {
-                                    let (u, vv) = v.plane_at(px, py)?;
-                                    self.shade(u, vv, v.front)
-                                })
-                                .unwrap_or(background[y * w + x]);
+                            let g = self.sample(view, px, py).unwrap_or(background[y * w + x]);
                             sum += g;
                             n += 1.0;
                         }
@@ -305,35 +306,33 @@ impl Scene {
     /// Pixel box (x0, y0, x1, y1) holding the body in every sub-exposure view.
     fn bbox(
         &self,
-        views: &[Option<PlaneView>],
+        views: &[Vec<PlaneView>],
         t: f64,
         pose_at: &impl Fn(f64) -> Option<PoseSample>,
     ) -> Option<(usize, usize, usize, usize)> {
-        let (_, half_body, top, bottom) = self.extents();
         let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
         let mut any = false;
         for i in 0..views.len() {
             let dt = self.faults.exposure_s * ((i as f64 + 0.5) / views.len() as f64 - 0.5);
             let Some(p) = pose_at(t + dt) else { continue };
-            let (r, c) = camera_pose(
+            let (pos, q) = (
                 DVec3::from_array(p.pos),
-                glam::DQuat::from_xyzw(p.quat[1], p.quat[2], p.quat[3], p.quat[0]),
+                DQuat::from_xyzw(p.quat[1], p.quat[2], p.quat[3], p.quat[0]),
             );
-            for (u, v) in [
-                (-half_body, -top),
-                (half_body, -top),
-                (half_body, bottom),
-                (-half_body, bottom),
-            ] {
-                let q = r * DVec3::new(u, v, 0.0) + c;
-                let Some([px, py]) = super::pose::project(&self.intrinsics, q) else {
-                    return Some((0, 0, self.width, self.height));
-                };
-                x0 = x0.min(px);
-                y0 = y0.min(py);
-                x1 = x1.max(px);
-                y1 = y1.max(py);
-                any = true;
+            for panel in &self.body.panels {
+                let (pp, pq) = self.body.panel_pose(panel, pos, q);
+                let (r, c) = camera_pose(pp, pq);
+                for (u, v) in panel_corners(panel) {
+                    let q = r * DVec3::new(u, v, 0.0) + c;
+                    let Some([px, py]) = super::pose::project(&self.intrinsics, q) else {
+                        return Some((0, 0, self.width, self.height));
+                    };
+                    x0 = x0.min(px);
+                    y0 = y0.min(py);
+                    x1 = x1.max(px);
+                    y1 = y1.max(py);
+                    any = true;
+                }
             }
         }
         if !any {
@@ -349,9 +348,9 @@ impl Scene {
         (b.0 < b.2 && b.1 < b.3).then_some(b)
     }
 
-    /// Lays a finger over a corner of the card during occlusion episodes; whether it covers
-    /// the tag's pattern.
-    fn occlude(&self, img: &mut [f64], t: f64, views: &[Option<PlaneView>]) -> bool {
+    /// Lays a finger over a corner of a card during occlusion episodes — the card most
+    /// turned toward the camera —; whether it covers a tag's pattern.
+    fn occlude(&self, img: &mut [f64], t: f64, views: &[Vec<PlaneView>]) -> bool {
         let every = self.faults.occlusion_every_s;
         if every <= 0.0 {
             return false;
@@ -364,15 +363,24 @@ impl Scene {
         if t < start || t > start + 0.3 {
             return false;
         }
-        let Some(view) = views.get(views.len() / 2).and_then(Option::as_ref) else {
+        let Some(view) = views[views.len() / 2]
+            .iter()
+            .filter(|v| self.body.panels[v.panel].tag.is_some())
+            .max_by(|a, b| a.facing.total_cmp(&b.facing))
+        else {
             return false;
         };
+        let panel = &self.body.panels[view.panel];
+        let (cell, border) = (
+            self.body.cell(panel),
+            panel.tag.as_ref().map_or(0, |t| t.border_width),
+        );
         // The finger's tip sits a cell inside the pattern's corner; its width one fifth of
         // the tag, reaching outward off the card.
         let Ok(fwd) = view_forward(view) else {
             return false;
         };
-        let half = self.cell() * self.tag.border_width as f64 / 2.0 - self.cell();
+        let half = cell * border as f64 / 2.0 - cell;
         let (su, sv) = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)][corner];
         let tip = fwd * DVec3::new(su * half, sv * half, 1.0);
         let out = fwd * DVec3::new(su * half * 3.0, sv * half * 3.0, 1.0);
@@ -411,6 +419,12 @@ impl Scene {
             *v *= level * (1.0 + 0.5 * swing * x);
         }
     }
+}
+
+/// A panel's four corners in its plane coordinates (u, v), metres.
+fn panel_corners(panel: &Panel) -> [(f64, f64); 4] {
+    let (w, top, bottom) = (panel.half_width, panel.top, panel.bottom);
+    [(-w, -top), (w, -top), (w, bottom), (-w, bottom)]
 }
 
 /// The plane's homography to pixels (the inverse of the stored one).
@@ -464,8 +478,7 @@ pub(crate) mod tests {
             width: 640,
             height: 480,
             intrinsics: intrinsics_from_fov(640, 480, 60.0),
-            tag: tag_pattern(Family::Tag36h11, 0).unwrap(),
-            tag_size: 0.04,
+            body: Body::chest(tag_pattern(Family::Tag36h11, 0).unwrap(), 0.04),
             faults,
             seed,
         }

@@ -1,19 +1,21 @@
-//! One tag followed frame by frame: detection → the chosen id → pose → a pose-log sample.
+//! One tag — or the tags of a rig around the figurine — followed frame by frame: detection →
+//! the rig's ids → a pose per tag → one figurine pose ([`super::fuse`]) → a pose-log sample.
 //!
-//! The tag is looked for first in a region around where it was last seen, moved on at its
-//! image velocity (about a millisecond, where the whole 640×480 frame takes tens), and in
-//! the whole frame when it is not found there or was not seen lately. The region finds the
-//! corners the whole frame would, to within a tenth of a pixel.
+//! The tags are looked for first in a region around where the rig was last seen, moved on at
+//! its image velocity (about a millisecond, where the whole 640×480 frame takes tens), and in
+//! the whole frame when none is found there or the rig was not seen lately. The region finds
+//! the corners the whole frame would, to within a tenth of a pixel.
 //!
-//! Where the tag is not found, or found with a pose the library itself finds poor, the frame
-//! gives no sample: the recognizer treats the gap as a gap. The quaternion's sign is kept
-//! continuous from sample to sample (q and −q are the same pose; a steady sign reads better).
+//! Where no tag is found, or none with a pose the tracker trusts, the frame gives no sample:
+//! the recognizer treats the gap as a gap. The quaternion's sign is kept continuous from
+//! sample to sample (q and −q are the same pose; a steady sign reads better).
 
-use glam::DQuat;
+use glam::{DQuat, DVec3};
 
-use super::detect::{Detection, Detector, GrayFrame, Intrinsics, Region};
-use super::pnp::solve_pose;
-use super::pose::figurine_pose;
+use super::detect::{CameraPose, Detection, Detector, GrayFrame, Intrinsics, Region};
+use super::fuse::{fuse, solve_tags};
+use super::pose::{figurine_pose, project};
+use super::rig::Rig;
 use super::smooth::OrientationFilter;
 use crate::poselog::PoseSample;
 
@@ -35,24 +37,28 @@ pub const MIN_SEARCH_MARGIN_PX: f64 = 16.0;
 /// longer gap the tag may be anywhere and the whole frame is searched.
 pub const MAX_SEARCH_GAP_S: f64 = 0.1;
 
-/// Where the tag was last seen, for searching near it first.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Where the rig was last seen, for searching near it first.
+#[derive(Debug, Clone, PartialEq)]
 struct Seen {
     t: f64,
-    corners: [[f64; 2]; 4],
-    /// Image velocity of the tag's centre, pixels per second (zero after one sighting).
+    /// The tag's corners (one tag), or every rig tag's corners at the pose found (a rig: so a
+    /// face turning into view is inside the region too), pixels.
+    points: Vec<[f64; 2]>,
+    /// Longest side of a tag found, pixels.
+    side: f64,
+    /// Image velocity of the points' centre, pixels per second (zero after one sighting).
     velocity: [f64; 2],
 }
 
-/// Follows one tag id.
+/// Follows one tag id, or the tags of a rig around the figurine.
 #[derive(Debug)]
 pub struct Tracker {
     detector: Detector,
-    id: u32,
-    tag_size: f64,
+    rig: Rig,
     intrinsics: Intrinsics,
     last: Option<DQuat>,
-    last_cam: Option<DQuat>,
+    /// The body's last trusted rotation in the camera frame (tag convention).
+    last_body: Option<DQuat>,
     smooth: Option<OrientationFilter>,
     seen: Option<Seen>,
     search_near: bool,
@@ -61,11 +67,13 @@ pub struct Tracker {
 /// What one frame gave.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameResult {
-    /// The sample, when the tag was seen with a trusted pose.
+    /// The sample, when a tag was seen with a trusted pose.
     pub sample: Option<PoseSample>,
-    /// The detection of the tracked id, if any (for overlays).
+    /// The largest detection of a tracked id, if any (for overlays).
     pub detection: Option<Detection>,
-    /// Its pose in the camera frame, trusted or not.
+    /// Every tag of the rig found, in the rig's order.
+    pub detections: Vec<Detection>,
+    /// The body's pose in the camera frame (for one tag, the tag's), trusted or not.
     pub pose: Option<super::detect::CameraPose>,
     /// The region searched first, near the tag's last place (`None`: the whole frame only).
     pub region: Option<Region>,
@@ -75,13 +83,18 @@ impl Tracker {
     /// Follows tag `id` (edge of its black square `tag_size` metres) through a camera with
     /// `intrinsics`.
     pub fn new(detector: Detector, id: u32, tag_size: f64, intrinsics: Intrinsics) -> Self {
+        Self::with_rig(detector, Rig::single(id, tag_size), intrinsics)
+    }
+
+    /// Follows the tags of `rig` (of the detector's family) through a camera with
+    /// `intrinsics`.
+    pub fn with_rig(detector: Detector, rig: Rig, intrinsics: Intrinsics) -> Self {
         Self {
             detector,
-            id,
-            tag_size,
+            rig,
             intrinsics,
             last: None,
-            last_cam: None,
+            last_body: None,
             smooth: None,
             seen: None,
             search_near: true,
@@ -106,36 +119,32 @@ impl Tracker {
         self.intrinsics
     }
 
+    /// The rig followed.
+    pub fn rig(&self) -> &Rig {
+        &self.rig
+    }
+
     /// Processes the frame taken at `t` seconds.
     pub fn frame(&mut self, t: f64, frame: &GrayFrame) -> FrameResult {
         let near = self.search_region(t, frame);
-        let id = self.id;
-        let mut best = near.and_then(|r| clearest(id, self.detector.detect_in(frame, r)));
-        if best.is_none() {
-            best = clearest(id, self.detector.detect(frame));
+        let mut found = near
+            .map(|r| clearest(&self.rig, self.detector.detect_in(frame, r)))
+            .unwrap_or_default();
+        if found.is_empty() {
+            found = clearest(&self.rig, self.detector.detect(frame));
         }
-        self.seen = best.as_ref().map(|d| {
-            let velocity = match self.seen {
-                Some(s) if t > s.t && t - s.t <= MAX_SEARCH_GAP_S => {
-                    let (a, b) = (centre(&s.corners), centre(&d.corners));
-                    [(b[0] - a[0]) / (t - s.t), (b[1] - a[1]) / (t - s.t)]
-                }
-                _ => [0.0; 2],
-            };
-            Seen {
-                t,
-                corners: d.corners,
-                velocity,
-            }
-        });
-        let pose = best
-            .as_ref()
-            .and_then(|d| solve_pose(&d.corners, self.tag_size, &self.intrinsics, self.last_cam));
-        let sample = pose.as_ref().and_then(|pose| {
-            if pose.error > MAX_POSE_ERROR_PX {
-                return None;
-            }
-            self.last_cam = Some(pose.quat());
+        let k = self.intrinsics;
+        let tags = solve_tags(&self.rig, found.clone(), &k, self.last_body);
+        let fused = fuse(&self.rig, &tags, &k);
+        let largest = tags
+            .iter()
+            .max_by(|a, b| a.area_px().total_cmp(&b.area_px()));
+        let best = largest
+            .map(|s| s.detection.clone())
+            .or_else(|| found.first().cloned());
+        self.remember(t, &found, fused.as_ref());
+        let sample = fused.as_ref().map(|pose| {
+            self.last_body = Some(pose.quat());
             let (p, mut q) = figurine_pose(pose);
             if let Some(f) = &mut self.smooth {
                 q = f.push(t, q);
@@ -146,60 +155,114 @@ impl Tracker {
                 }
             }
             self.last = Some(q);
-            Some(PoseSample {
+            PoseSample {
                 t,
                 pos: p.to_array(),
                 quat: [q.w, q.x, q.y, q.z],
-            })
+            }
         });
         FrameResult {
             sample,
             detection: best,
-            pose,
+            detections: found,
+            pose: fused.or_else(|| largest.map(|s| s.body)),
             region: near,
         }
     }
+
+    /// Keeps where the rig was seen at `t` for the next frame's region search: one tag's
+    /// corners, or for a rig every tag's corners at the pose found (a face turning into view
+    /// is then inside the region); nothing when no tag was found.
+    fn remember(&mut self, t: f64, found: &[Detection], pose: Option<&CameraPose>) {
+        if found.is_empty() {
+            self.seen = None;
+            return;
+        }
+        let k = self.intrinsics;
+        let projected: Vec<[f64; 2]> = match pose {
+            Some(pose) if self.rig.faces.len() > 1 => {
+                let (r, tr) = (pose.matrix(), DVec3::from_array(pose.translation));
+                self.rig
+                    .faces
+                    .iter()
+                    .flat_map(|f| f.corners_in_body(self.rig.tag_size))
+                    .filter_map(|c| project(&k, r * c + tr))
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
+        let points = if projected.is_empty() {
+            found.iter().flat_map(|d| d.corners).collect()
+        } else {
+            projected
+        };
+        let side = found
+            .iter()
+            .flat_map(|d| {
+                (0..4).map(|i| {
+                    let (a, b) = (d.corners[i], d.corners[(i + 1) % 4]);
+                    (a[0] - b[0]).hypot(a[1] - b[1])
+                })
+            })
+            .fold(0.0, f64::max);
+        let velocity = match &self.seen {
+            Some(s) if t > s.t && t - s.t <= MAX_SEARCH_GAP_S => {
+                let (a, b) = (centre(&s.points), centre(&points));
+                [(b[0] - a[0]) / (t - s.t), (b[1] - a[1]) / (t - s.t)]
+            }
+            _ => [0.0; 2],
+        };
+        self.seen = Some(Seen {
+            t,
+            points,
+            side,
+            velocity,
+        });
+    }
 }
 
-/// Several copies of one id (a reflection, a second print): the clearest read wins.
-fn clearest(id: u32, found: Vec<Detection>) -> Option<Detection> {
-    found.into_iter().filter(|d| d.id == id).min_by(|a, b| {
-        (a.hamming, -a.margin)
-            .partial_cmp(&(b.hamming, -b.margin))
-            .unwrap_or(std::cmp::Ordering::Equal)
-    })
+/// The rig's tags among what the detector found, one per id (several copies of one id — a
+/// reflection, a second print —: the clearest read wins), in the rig's order.
+fn clearest(rig: &Rig, found: Vec<Detection>) -> Vec<Detection> {
+    rig.faces
+        .iter()
+        .filter_map(|f| {
+            found.iter().filter(|d| d.id == f.id).min_by(|a, b| {
+                (a.hamming, -a.margin)
+                    .partial_cmp(&(b.hamming, -b.margin))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+        })
+        .cloned()
+        .collect()
 }
 
 impl Tracker {
-    /// The region to search first at `t`: the last corners moved on at the tag's image
-    /// velocity, grown by a margin of [`SEARCH_MARGIN_TAGS`] tag widths plus the distance the
-    /// tag moved in the last frame (a change of speed up to the speed itself is still found);
-    /// `None` when the tag was not seen lately or the region would be most of the frame.
+    /// The region to search first at `t`: the last points moved on at their image velocity,
+    /// grown by a margin of [`SEARCH_MARGIN_TAGS`] tag widths plus the distance they moved in
+    /// the last frame (a change of speed up to the speed itself is still found); `None` when
+    /// the rig was not seen lately or the region would be most of the frame.
     fn search_region(&self, t: f64, frame: &GrayFrame) -> Option<Region> {
-        let seen = self.seen.filter(|_| self.search_near)?;
+        let seen = self.seen.as_ref().filter(|_| self.search_near)?;
         let dt = t - seen.t;
         if !(dt > 0.0 && dt <= MAX_SEARCH_GAP_S) {
             return None;
         }
         let (vx, vy) = (seen.velocity[0] * dt, seen.velocity[1] * dt);
-        let moved = seen.corners.map(|[x, y]| [x + vx, y + vy]);
-        let side = (0..4)
-            .map(|i| {
-                let (a, b) = (seen.corners[i], seen.corners[(i + 1) % 4]);
-                (a[0] - b[0]).hypot(a[1] - b[1])
-            })
-            .fold(0.0, f64::max);
-        let margin = (SEARCH_MARGIN_TAGS * side).max(MIN_SEARCH_MARGIN_PX) + vx.hypot(vy);
+        let moved: Vec<[f64; 2]> = seen.points.iter().map(|[x, y]| [x + vx, y + vy]).collect();
+        let margin = (SEARCH_MARGIN_TAGS * seen.side).max(MIN_SEARCH_MARGIN_PX) + vx.hypot(vy);
         let r = Region::around(&moved, margin, frame.width, frame.height)?;
         (2 * r.area() < frame.width * frame.height).then_some(r)
     }
 }
 
-fn centre(c: &[[f64; 2]; 4]) -> [f64; 2] {
-    [
-        (c[0][0] + c[1][0] + c[2][0] + c[3][0]) / 4.0,
-        (c[0][1] + c[1][1] + c[2][1] + c[3][1]) / 4.0,
-    ]
+/// The mean of the points, pixels.
+fn centre(points: &[[f64; 2]]) -> [f64; 2] {
+    let n = points.len().max(1) as f64;
+    let (x, y) = points
+        .iter()
+        .fold((0.0, 0.0), |(x, y), p| (x + p[0], y + p[1]));
+    [x / n, y / n]
 }
 
 /// A whole source tracked.
@@ -251,7 +314,7 @@ mod tests {
 
     fn tracker(scene: &Scene) -> Tracker {
         let d = Detector::new(Family::Tag36h11, DetectorSettings::default()).unwrap();
-        Tracker::new(d, 0, scene.tag_size, scene.intrinsics).with_smoothing(true)
+        Tracker::new(d, 0, scene.body.tag_size, scene.intrinsics).with_smoothing(true)
     }
 
     /// A figurine sliding across the view at 0.6 m/s, 0.7 m away, turning a little.
@@ -293,6 +356,47 @@ mod tests {
             in_region >= 13,
             "searched near the tag in {in_region} of 15 frames"
         );
+    }
+
+    #[test]
+    fn two_faces_of_a_rendered_rig_agree_on_the_figurine_s_pose() {
+        use crate::track::body::Body;
+        use crate::track::detect::tag_pattern;
+        use crate::track::fuse::solve_tags;
+        use crate::track::pose::angle_between_deg;
+        let rig = Rig::boxed(0, 0.04, 0.08, 0.08);
+        let patterns = (0..4)
+            .map(|id| tag_pattern(Family::Tag36h11, id).unwrap())
+            .collect();
+        let s = Scene {
+            body: Body::rig_box(&rig, patterns, 0.08, 0.08),
+            ..scene()
+        };
+        let d = Detector::new(Family::Tag36h11, DetectorSettings::default()).unwrap();
+        let mut tr = Tracker::with_rig(d, rig.clone(), s.intrinsics);
+        // Turned 45° to its right, 0.6 m ahead: the front and the left face equally in sight.
+        let q = DQuat::from_rotation_y(-45f64.to_radians());
+        let truth = PoseSample {
+            t: 0.0,
+            pos: [0.01, 0.0, -0.6],
+            quat: [q.w, q.x, q.y, q.z],
+        };
+        let frame = s.render(&s.background(), 0, 0.0, |_| Some(truth)).frame;
+        let r = tr.frame(0.0, &frame);
+        let ids: Vec<u32> = r.detections.iter().map(|d| d.id).collect();
+        assert_eq!(ids, [0, 1], "the front and the left tag");
+        let tags = solve_tags(&rig, r.detections.clone(), &s.intrinsics, None);
+        let poses: Vec<_> = tags.iter().map(|t| figurine_pose(&t.body)).collect();
+        let apart = (poses[0].0 - poses[1].0).length() * 1000.0;
+        let turn = angle_between_deg(poses[0].1, poses[1].1);
+        assert!(apart < 8.0, "{apart:.1} mm apart");
+        assert!(turn < 4.0, "{turn:.2}° apart");
+        // And the one sample of both is near the truth.
+        let got = r.sample.expect("a sample");
+        let err = (glam::DVec3::from_array(got.pos) - glam::DVec3::from_array(truth.pos)).length();
+        assert!(err < 5e-3, "{:.1} mm off", err * 1000.0);
+        let got_q = DQuat::from_xyzw(got.quat[1], got.quat[2], got.quat[3], got.quat[0]);
+        assert!(angle_between_deg(got_q, q) < 2.0);
     }
 
     #[test]

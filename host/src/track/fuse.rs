@@ -1,0 +1,182 @@
+//! One figurine pose from every tag of the rig in sight.
+//!
+//! Each tag found is solved on its own ([`super::pnp::solve_pose`]) and carried to the body
+//! through its face's fixed place ([`super::rig::Face::body_from_tag`]). With one trusted tag
+//! that is the pose. With two or more, one pose is refined on all their corners together:
+//! points on two planes at an angle admit no mirror pose, and the steeper tag — whose
+//! foreshortening shows its tilt by whole pixels — pins the orientation that a face-on tag
+//! reads only from hundredths of a pixel. The refinement starts from each tag's own pose and
+//! keeps the best fit; when even that fits badly (the tags disagree: a misread, a rig measured
+//! wrong) the largest tag in the picture is trusted alone.
+
+use glam::{DQuat, DVec2, DVec3};
+
+use super::detect::{CameraPose, Detection, Intrinsics};
+use super::pnp::{refine, solve_pose};
+use super::rig::Rig;
+use super::tracker::MAX_POSE_ERROR_PX;
+
+/// One tag of the rig found in a frame and solved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TagSeen {
+    /// What the detector found.
+    pub detection: Detection,
+    /// The tag's own camera-frame pose (trusted or not: see its error).
+    pub tag: CameraPose,
+    /// The body's camera-frame pose this tag alone gives.
+    pub body: CameraPose,
+}
+
+impl TagSeen {
+    /// The tag's area in the picture, square pixels.
+    pub fn area_px(&self) -> f64 {
+        let c = &self.detection.corners;
+        let twice: f64 = (0..4)
+            .map(|i| {
+                let (a, b) = (c[i], c[(i + 1) % 4]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        twice.abs() / 2.0
+    }
+
+    /// Whether its corners fit a flat square well enough to trust.
+    pub fn trusted(&self) -> bool {
+        self.tag.error <= MAX_POSE_ERROR_PX
+    }
+}
+
+/// Solves every detection of a rig tag; `last_body` (the body's last tag-convention rotation
+/// in the camera frame) breaks each tag's near-ties between its two mirror poses.
+pub fn solve_tags(
+    rig: &Rig,
+    found: Vec<Detection>,
+    k: &Intrinsics,
+    last_body: Option<DQuat>,
+) -> Vec<TagSeen> {
+    found
+        .into_iter()
+        .filter_map(|d| {
+            let face = rig.face(d.id)?;
+            let previous = last_body.map(|b| face.tag_rotation(b));
+            let tag = solve_pose(&d.corners, rig.tag_size, k, previous)?;
+            let body = face.body_from_tag(&tag);
+            Some(TagSeen {
+                detection: d,
+                tag,
+                body,
+            })
+        })
+        .collect()
+}
+
+/// The body's pose from the tags seen: `None` when no tag is trusted.
+pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<CameraPose> {
+    let trusted: Vec<&TagSeen> = seen.iter().filter(|s| s.trusted()).collect();
+    let largest = trusted
+        .iter()
+        .max_by(|a, b| a.area_px().total_cmp(&b.area_px()))
+        .map(|s| s.body)?;
+    if trusted.len() < 2 {
+        return Some(largest);
+    }
+    let (mut obj, mut px) = (Vec::new(), Vec::new());
+    for s in &trusted {
+        let face = rig.face(s.detection.id)?;
+        obj.extend(face.corners_in_body(rig.tag_size));
+        px.extend(s.detection.corners.map(|c| DVec2::new(c[0], c[1])));
+    }
+    let best = trusted
+        .iter()
+        .map(|s| {
+            let (q, t) = (s.body.quat(), DVec3::from_array(s.body.translation));
+            refine(q, t, &obj, &px, k)
+        })
+        .filter(|(q, t, err)| q.is_finite() && t.is_finite() && err.is_finite())
+        .min_by(|a, b| a.2.total_cmp(&b.2));
+    match best {
+        Some((q, t, err)) if err <= MAX_POSE_ERROR_PX => {
+            Some(CameraPose::from_parts(glam::DMat3::from_quat(q), t, err))
+        }
+        _ => Some(largest),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::pose::{angle_between_deg, camera_pose, figurine_pose, intrinsics_from_fov};
+
+    /// The detections a perfect detector would give of the rig's tags turned toward the
+    /// camera (more than 10° from edge-on), the corners shifted by `jitter(i)` pixels.
+    fn seen(
+        rig: &Rig,
+        p: DVec3,
+        q: DQuat,
+        k: &Intrinsics,
+        jitter: impl Fn(usize) -> f64,
+    ) -> Vec<Detection> {
+        let (r, t) = camera_pose(p, q);
+        let mut n = 0;
+        let mut out = Vec::new();
+        for f in &rig.faces {
+            let c = f.corners_in_body(rig.tag_size).map(|o| r * o + t);
+            // Its printed x crossed with its printed up: the tag's outward normal.
+            let outward = (c[1] - c[0]).cross(c[3] - c[0]).normalize();
+            let to_camera = -(c[0] + c[2]) / 2.0;
+            if outward.dot(to_camera.normalize()) < 10f64.to_radians().sin() {
+                continue;
+            }
+            let corners = c.map(|v| {
+                n += 1;
+                let j = jitter(n);
+                [k.cx + k.fx * v.x / v.z + j, k.cy + k.fy * v.y / v.z - j]
+            });
+            out.push(Detection {
+                id: f.id,
+                hamming: 0,
+                margin: 50.0,
+                corners,
+                center: [0.0; 2],
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn two_faces_in_sight_give_one_pose_no_worse_than_either() {
+        let k = intrinsics_from_fov(640, 480, 60.0);
+        let rig = Rig::boxed(0, 0.04, 0.08, 0.08);
+        let p = DVec3::new(0.03, 0.01, -0.9);
+        // Turned 40° to its right (its left shoulder toward the camera): the front and the
+        // left face both in sight.
+        let q = DQuat::from_euler(glam::EulerRot::YXZ, -40f64.to_radians(), 0.05, 0.0);
+        let jitter = |i: usize| 0.15 * ((i * 7919 % 13) as f64 / 6.0 - 1.0);
+        let found = seen(&rig, p, q, &k, jitter);
+        assert_eq!(found.iter().map(|d| d.id).collect::<Vec<_>>(), [0, 1]);
+        let tags = solve_tags(
+            &rig,
+            found,
+            &k,
+            Some(DQuat::from_mat3(&camera_pose(p, q).0)),
+        );
+        let err = |c: &CameraPose| {
+            let (p2, q2) = figurine_pose(c);
+            ((p2 - p).length() * 1000.0, angle_between_deg(q, q2))
+        };
+        let fused = err(&fuse(&rig, &tags, &k).unwrap());
+        for t in &tags {
+            let one = err(&t.body);
+            assert!(
+                fused.1 <= one.1 + 0.05,
+                "fused {fused:?}, tag {}: {one:?}",
+                t.detection.id
+            );
+        }
+        assert!(fused.0 < 3.0 && fused.1 < 0.5, "{fused:?}");
+        // No tag trusted, no pose: a tag whose corners no square explains.
+        let mut bad = tags[0].clone();
+        bad.tag.error = MAX_POSE_ERROR_PX * 2.0;
+        assert!(fuse(&rig, &[bad], &k).is_none());
+    }
+}
