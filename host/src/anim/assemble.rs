@@ -40,13 +40,13 @@ use std::collections::BTreeMap;
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::contact::{detect_contacts, find_legs, fix_ground, pin_feet, GroundFix};
+use super::contact::{detect_contacts, find_legs, pin_feet};
 use super::effort::{apply_effort, Effort, EffortClip};
-use super::footing::{clear_swing_feet, planted};
+use super::footing::{clear_swing_feet, fix_ground, planted, GroundFix};
 use super::graph_cuts::{GraphGuide, PlacedSource};
 use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
-use super::mirror::pick_side;
+use super::mirror::plays_mirrored;
 use super::pacing::{
     ground_travel, pace, root_speed_max, shrink, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM,
 };
@@ -323,13 +323,19 @@ pub fn assemble_guided(
             guide,
         );
         // A clip stepping to one side steps towards the side the doodle moves.
-        let ac = match &path {
-            Some(p) if ac.moving => pick_side(
-                ac,
-                &p.chunk(ev.start as f32, ev.end as f32),
-                cursor.heading,
-                forward,
-            ),
+        let ac = match (&path, ac.mirrored.as_deref()) {
+            (Some(p), Some(m))
+                if ac.moving
+                    && plays_mirrored(
+                        &ac.clip,
+                        Some(&m.clip),
+                        &p.chunk(ev.start as f32, ev.end as f32),
+                        cursor.heading,
+                        forward,
+                    ) =>
+            {
+                m
+            }
             _ => ac,
         };
         // Caches are per variant.

@@ -176,17 +176,6 @@ pub fn pin_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) {
     }
 }
 
-/// What the ground pass changed.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct GroundFix {
-    /// Frames where IK bent a leg.
-    pub ik_frames: usize,
-    /// Frames where the root had to be raised.
-    pub raised_frames: usize,
-    /// Deepest penetration found before the fix, metres.
-    pub max_depth: f32,
-}
-
 /// Per frame of `clip`, per leg: the height of the foot's lowest point (∞ without points).
 fn foot_heights(clip: &Clip, legs: &[Leg]) -> Vec<Vec<f32>> {
     clip.frames
@@ -378,53 +367,6 @@ pub fn keep_feet_above_floor(src: &Clip, out: &mut Clip) -> usize {
     changed
 }
 
-/// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
-/// cannot reach, the root is raised by what remains — evenly over the frames around
-/// ([`super::footing::raise_evenly`]), so the body rises and settles as a person's would
-/// rather than popping up for a frame.
-pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
-    let mut fix = GroundFix::default();
-    let sk = clip.skeleton.clone();
-    let mut need = vec![0.0f32; clip.len()];
-    for (pose, need) in clip.frames.iter_mut().zip(&mut need) {
-        let mut bent = false;
-        for leg in legs {
-            let world = sk.forward(pose);
-            let low = leg
-                .foot
-                .iter()
-                .map(|&j| world[j].position.y)
-                .fold(f32::INFINITY, f32::min);
-            let depth = GROUND_Y - low;
-            if depth <= 0.0 || !depth.is_finite() {
-                continue;
-            }
-            fix.max_depth = fix.max_depth.max(depth);
-            let target = world[leg.ankle].position + Vec3::Y * (depth + 1e-4);
-            two_bone_ik(&sk, pose, leg, target);
-            bent = true;
-        }
-        // Whatever IK could not reach: raise the whole body.
-        let world = sk.positions(pose);
-        let low = legs
-            .iter()
-            .flat_map(|l| l.foot.iter())
-            .map(|&j| world[j].y)
-            .fold(f32::INFINITY, f32::min);
-        if low < GROUND_Y && low.is_finite() {
-            *need = GROUND_Y - low + 1e-4;
-            fix.raised_frames += 1;
-        }
-        if bent {
-            fix.ik_frames += 1;
-        }
-    }
-    if fix.raised_frames > 0 {
-        super::footing::raise_evenly(clip, legs, &need);
-    }
-    fix
-}
-
 /// Least forward bend (rad) of a knee before IK bends it further: the solver keeps the side
 /// a knee is bent to, so a straight or overextended knee is first turned this far forward.
 pub const KNEE_FORWARD_RAD: f32 = 0.05;
@@ -545,24 +487,30 @@ fn bend_knee_forward(sk: &Skeleton, pose: &mut crate::motion::Pose, leg: &Leg) {
     pose.rotations[leg.knee] = (pose.rotations[leg.knee] * turn).normalize();
 }
 
+/// A pelvis with one leg (hip, knee, ankle, toe pointing +Z) and a head, for tests.
 #[cfg(test)]
-mod tests {
+pub(crate) fn leg_skeleton() -> Skeleton {
+    let j = crate::motion::skeleton::Joint::bare;
+    Skeleton {
+        joints: vec![
+            j("pelvis", None, Vec3::ZERO),
+            j("hip", Some(0), Vec3::new(0.1, 0.0, 0.0)),
+            j("knee", Some(1), Vec3::new(0.0, -0.45, 0.0)),
+            j("ankle", Some(2), Vec3::new(0.0, -0.45, 0.0)),
+            j("toe", Some(3), Vec3::new(0.0, -0.05, 0.12)),
+            j("head", Some(0), Vec3::new(0.0, 0.7, 0.0)),
+        ],
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
     use super::*;
-    use crate::motion::skeleton::Joint;
     use crate::motion::Pose;
 
-    fn leg_clip() -> Clip {
-        let j = Joint::bare;
-        let sk = Skeleton {
-            joints: vec![
-                j("pelvis", None, Vec3::ZERO),
-                j("hip", Some(0), Vec3::new(0.1, 0.0, 0.0)),
-                j("knee", Some(1), Vec3::new(0.0, -0.45, 0.0)),
-                j("ankle", Some(2), Vec3::new(0.0, -0.45, 0.0)),
-                j("toe", Some(3), Vec3::new(0.0, -0.05, 0.12)),
-                j("head", Some(0), Vec3::new(0.0, 0.7, 0.0)),
-            ],
-        };
+    /// One leg whose toe stands 5 cm under the ground, its knee bent 0.2 rad: two frames.
+    pub(crate) fn leg_clip() -> Clip {
+        let sk = leg_skeleton();
         let mut p = Pose::rest(&sk);
         p.translations[0] = Vec3::new(0.0, 0.9, 0.0); // toe at y = -0.05: 5 cm under ground
         p.rotations[2] = Quat::from_rotation_x(0.2);
@@ -572,22 +520,6 @@ mod tests {
             frame_time: 1.0 / 30.0,
             frames: vec![p.clone(), p],
         }
-    }
-
-    #[test]
-    fn finds_the_leg_and_lifts_the_foot_with_ik() {
-        let mut c = leg_clip();
-        let legs = find_legs(&c);
-        assert_eq!(legs.len(), 1, "{legs:?}");
-        assert_eq!((legs[0].hip, legs[0].knee, legs[0].ankle), (1, 2, 3));
-        let before = c.joint_positions(0);
-        let fix = fix_ground(&mut c, &legs);
-        let after = c.joint_positions(0);
-        assert!(fix.max_depth > 0.0 && fix.ik_frames == 2, "{fix:?}");
-        assert!(after[4].y >= -1e-5 && after[3].y >= -1e-5, "{after:?}");
-        // The pelvis did not move: IK alone did it (the bent knee has slack).
-        assert!((after[0] - before[0]).length() < 1e-6);
-        assert_eq!(fix.raised_frames, 0);
     }
 
     #[test]
@@ -635,19 +567,6 @@ mod tests {
         }
         assert_eq!(out.frames[0], src.frames[0]);
         assert_eq!(out.frames[19], src.frames[19]);
-    }
-
-    #[test]
-    fn unreachable_targets_raise_the_root() {
-        let mut c = leg_clip();
-        for p in &mut c.frames {
-            p.translations[0].y = -1.5; // hip 1.5 m under ground: the leg cannot reach
-        }
-        let legs = find_legs(&c);
-        let fix = fix_ground(&mut c, &legs);
-        assert_eq!(fix.raised_frames, 2);
-        let p = c.joint_positions(1);
-        assert!(p[3].y >= -1e-4 && p[4].y >= -1e-4, "{p:?}");
     }
 
     #[test]

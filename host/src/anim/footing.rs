@@ -114,7 +114,7 @@ pub fn clear_swing_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) -
 pub const RAISE_EASE_FRAMES: usize = 4;
 
 /// Raises the root of each frame of `clip` by at least `need[f]` metres (what its legs could
-/// not reach of the ground; [`super::contact::fix_ground`]), the raise spread over
+/// not reach of the ground; [`fix_ground`]), the raise spread over
 /// [`RAISE_EASE_FRAMES`] either side: per frame the mean, over that window, of the largest
 /// need within the same window of each frame, which is never less than any frame's own need
 /// (each window maximum averaged saw it) and changes evenly. Raised in one frame alone, the
@@ -199,27 +199,75 @@ fn set_foot_height(
     }
 }
 
+/// What the ground pass changed.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GroundFix {
+    /// Frames where IK bent a leg.
+    pub ik_frames: usize,
+    /// Frames where the root had to be raised.
+    pub raised_frames: usize,
+    /// Deepest penetration found before the fix, metres.
+    pub max_depth: f32,
+}
+
+/// Removes every foot's penetration below the ground: two-bone IK lifts the ankle; if the leg
+/// cannot reach, the root is raised by what remains — evenly over the frames around
+/// ([`raise_evenly`]), so the body rises and settles as a person's would
+/// rather than popping up for a frame.
+pub fn fix_ground(clip: &mut Clip, legs: &[Leg]) -> GroundFix {
+    let mut fix = GroundFix::default();
+    let sk = clip.skeleton.clone();
+    let mut need = vec![0.0f32; clip.len()];
+    for (pose, need) in clip.frames.iter_mut().zip(&mut need) {
+        let mut bent = false;
+        for leg in legs {
+            let world = sk.forward(pose);
+            let low = leg
+                .foot
+                .iter()
+                .map(|&j| world[j].position.y)
+                .fold(f32::INFINITY, f32::min);
+            let depth = GROUND_Y - low;
+            if depth <= 0.0 || !depth.is_finite() {
+                continue;
+            }
+            fix.max_depth = fix.max_depth.max(depth);
+            let target = world[leg.ankle].position + Vec3::Y * (depth + 1e-4);
+            two_bone_ik(&sk, pose, leg, target);
+            bent = true;
+        }
+        // Whatever IK could not reach: raise the whole body.
+        let world = sk.positions(pose);
+        let low = legs
+            .iter()
+            .flat_map(|l| l.foot.iter())
+            .map(|&j| world[j].y)
+            .fold(f32::INFINITY, f32::min);
+        if low < GROUND_Y && low.is_finite() {
+            *need = GROUND_Y - low + 1e-4;
+            fix.raised_frames += 1;
+        }
+        if bent {
+            fix.ik_frames += 1;
+        }
+    }
+    if fix.raised_frames > 0 {
+        raise_evenly(clip, legs, &need);
+    }
+    fix
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::anim::contact::find_legs;
-    use crate::motion::{Joint, Pose, Skeleton};
+    use crate::motion::Pose;
     use glam::Quat;
 
     /// One leg standing with its toe on the ground, the knee bent `knee` rad; `frames` frames
     /// at 30 fps, the foot swept along +Z at `speed` m/s (the hip carried with it).
     fn sweeping_leg(frames: usize, speed: f32, knee: f32) -> Clip {
-        let j = Joint::bare;
-        let sk = Skeleton {
-            joints: vec![
-                j("pelvis", None, Vec3::ZERO),
-                j("hip", Some(0), Vec3::new(0.1, 0.0, 0.0)),
-                j("knee", Some(1), Vec3::new(0.0, -0.45, 0.0)),
-                j("ankle", Some(2), Vec3::new(0.0, -0.45, 0.0)),
-                j("toe", Some(3), Vec3::new(0.0, -0.05, 0.12)),
-                j("head", Some(0), Vec3::new(0.0, 0.7, 0.0)),
-            ],
-        };
+        let sk = crate::anim::contact::leg_skeleton();
         let mut rest = Pose::rest(&sk);
         rest.rotations[2] = Quat::from_rotation_x(knee);
         let toe = sk.positions(&rest)[4].y;
@@ -336,5 +384,34 @@ mod tests {
             assert!((a - b).abs() < 1e-6, "{c:?}");
         }
         assert_eq!(clearance(&[false; 2]), vec![SWING_CLEARANCE_M; 2]);
+    }
+
+    #[test]
+    fn finds_the_leg_and_lifts_the_foot_with_ik() {
+        let mut c = crate::anim::contact::tests::leg_clip();
+        let legs = find_legs(&c);
+        assert_eq!(legs.len(), 1, "{legs:?}");
+        assert_eq!((legs[0].hip, legs[0].knee, legs[0].ankle), (1, 2, 3));
+        let before = c.joint_positions(0);
+        let fix = fix_ground(&mut c, &legs);
+        let after = c.joint_positions(0);
+        assert!(fix.max_depth > 0.0 && fix.ik_frames == 2, "{fix:?}");
+        assert!(after[4].y >= -1e-5 && after[3].y >= -1e-5, "{after:?}");
+        // The pelvis did not move: IK alone did it (the bent knee has slack).
+        assert!((after[0] - before[0]).length() < 1e-6);
+        assert_eq!(fix.raised_frames, 0);
+    }
+
+    #[test]
+    fn unreachable_targets_raise_the_root() {
+        let mut c = crate::anim::contact::tests::leg_clip();
+        for p in &mut c.frames {
+            p.translations[0].y = -1.5; // hip 1.5 m under ground: the leg cannot reach
+        }
+        let legs = find_legs(&c);
+        let fix = fix_ground(&mut c, &legs);
+        assert_eq!(fix.raised_frames, 2);
+        let p = c.joint_positions(1);
+        assert!(p[3].y >= -1e-4 && p[4].y >= -1e-4, "{p:?}");
     }
 }

@@ -136,7 +136,7 @@ pub struct ActionClip {
     /// `None` for clips built outside a library.
     pub ranges: Option<Arc<JointRanges>>,
     /// The clip's mirror image, for clips that step to one side (`both_sides`; see
-    /// [`super::mirror::pick_side`]).
+    /// [`super::mirror::plays_mirrored`]).
     pub mirrored: Option<Box<ActionClip>>,
 }
 

@@ -12,7 +12,6 @@
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::library::ActionClip;
 use super::trajectory::{ground, yaw_between, Polyline};
 use super::AnimError;
 use crate::graph::roles::{Role, RoleMap, RoleOverrides};
@@ -99,52 +98,50 @@ pub fn mirror(clip: &Clip) -> Result<Clip, AnimError> {
     Ok(out)
 }
 
-/// Which side a clip that steps to one side plays along `path` (a moving action's ground
-/// path, relative to its start): the clip or its mirror image ([`ActionClip::mirrored`]),
-/// whichever leaves the character facing nearest `heading` once its travel is turned onto the
-/// path — a step to the right when the path runs to the right of the heading, to the left
-/// otherwise. `forward` is the rig's facing in its clips. Other clips play as they are.
-pub fn pick_side<'a>(
-    ac: &'a ActionClip,
+/// Whether a clip that steps to one side should play as its mirror image `mirrored` along
+/// `path` (a moving action's ground path, relative to its start): whichever leaves the
+/// character facing nearest `heading` once its travel is turned onto the path — a step to the
+/// right when the path runs to the right of the heading, to the left otherwise. `forward` is
+/// the rig's facing in its clips. Without a mirror image, or a path to read, it plays as it is.
+pub fn plays_mirrored(
+    clip: &Clip,
+    mirrored: Option<&Clip>,
     path: &Polyline,
     heading: Vec2,
     forward: Vec3,
-) -> &'a ActionClip {
-    let (Some(m), Some(along)) = (ac.mirrored.as_deref(), path.tangent_at(0.0, 0.3)) else {
-        return ac;
+) -> bool {
+    let (Some(m), Some(along)) = (mirrored, path.tangent_at(0.0, 0.3)) else {
+        return false;
     };
-    let facing_along = |c: &ActionClip| {
-        let root = c.clip.root_path();
+    let facing_along = |c: &Clip| {
+        let root = c.root_path();
         let (Some(a), Some(b)) = (root.first(), root.last()) else {
             return f32::NEG_INFINITY;
         };
-        let q0 = c
-            .clip
-            .frames
-            .first()
-            .map_or(Quat::IDENTITY, |p| p.rotations[0]);
+        let q0 = c.frames.first().map_or(Quat::IDENTITY, |p| p.rotations[0]);
         let travel = ground(*b - *a).normalize_or(Vec2::X);
         let facing = ground(q0 * forward).normalize_or(Vec2::X);
         let world = ground(yaw_between(travel, along) * Vec3::new(facing.x, 0.0, facing.y));
         world.dot(heading)
     };
-    if facing_along(m) > facing_along(ac) {
-        m
-    } else {
-        ac
-    }
+    facing_along(m) > facing_along(clip)
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::motion::{Joint, Pose};
 
     fn rig() -> Skeleton {
+        stick_figure("root")
+    }
+
+    /// A symmetric stick figure facing +X (its right towards +Z) rooted at `root`.
+    pub(crate) fn stick_figure(root: &str) -> Skeleton {
         let j = |name: &str, parent: Option<usize>, offset: Vec3| Joint::bare(name, parent, offset);
         Skeleton {
             joints: vec![
-                j("root", None, Vec3::ZERO),
+                j(root, None, Vec3::ZERO),
                 j("left_hip", Some(0), Vec3::new(0.0, -0.1, -0.1)),
                 j("left_knee", Some(1), Vec3::new(0.0, -0.4, 0.0)),
                 j("left_ankle", Some(2), Vec3::new(0.0, -0.4, 0.0)),

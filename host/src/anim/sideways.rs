@@ -355,31 +355,11 @@ pub fn run_sideways(takes: &[std::path::PathBuf], urdf: Option<&std::path::Path>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::{Joint, Pose, Skeleton};
+    use crate::motion::Pose;
 
     /// A stick figure (facing +X, its right towards +Z) gliding at `v` m/s for 2 s.
     fn gliding(v: Vec3) -> Clip {
-        let j = |name: &str, parent: Option<usize>, offset: Vec3| Joint::bare(name, parent, offset);
-        let skeleton = Skeleton {
-            joints: vec![
-                j("hips", None, Vec3::ZERO),
-                j("left_hip", Some(0), Vec3::new(0.0, -0.1, -0.1)),
-                j("left_knee", Some(1), Vec3::new(0.0, -0.4, 0.0)),
-                j("left_ankle", Some(2), Vec3::new(0.0, -0.4, 0.0)),
-                j("right_hip", Some(0), Vec3::new(0.0, -0.1, 0.1)),
-                j("right_knee", Some(4), Vec3::new(0.0, -0.4, 0.0)),
-                j("right_ankle", Some(5), Vec3::new(0.0, -0.4, 0.0)),
-                j("chest", Some(0), Vec3::new(0.0, 0.3, 0.0)),
-                j("neck", Some(7), Vec3::new(0.0, 0.2, 0.0)),
-                j("head", Some(8), Vec3::new(0.0, 0.1, 0.0)),
-                j("left_shoulder", Some(7), Vec3::new(0.0, 0.1, -0.2)),
-                j("left_elbow", Some(10), Vec3::new(0.0, -0.3, 0.0)),
-                j("left_wrist", Some(11), Vec3::new(0.0, -0.25, 0.0)),
-                j("right_shoulder", Some(7), Vec3::new(0.0, 0.1, 0.2)),
-                j("right_elbow", Some(13), Vec3::new(0.0, -0.3, 0.0)),
-                j("right_wrist", Some(14), Vec3::new(0.0, -0.25, 0.0)),
-            ],
-        };
+        let skeleton = crate::anim::mirror::tests::stick_figure("hips");
         let dt = 1.0 / 30.0;
         let frames = (0..60)
             .map(|f| {

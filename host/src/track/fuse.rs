@@ -14,7 +14,11 @@ use glam::{DQuat, DVec2, DVec3};
 use super::detect::{CameraPose, Detection, Intrinsics};
 use super::pnp::{refine, solve_pose};
 use super::rig::Rig;
-use super::tracker::MAX_POSE_ERROR_PX;
+
+/// RMS corner reprojection error (pixels) above which a pose is not trusted: corners that no
+/// flat square explains (a misread, or a frame smeared by fast motion). Good poses sit
+/// well under a pixel.
+pub const MAX_POSE_ERROR_PX: f64 = 2.0;
 
 /// One tag of the rig found in a frame and solved.
 #[derive(Debug, Clone, PartialEq)]

@@ -19,11 +19,6 @@ use super::rig::Rig;
 use super::smooth::OrientationFilter;
 use crate::poselog::PoseSample;
 
-/// RMS corner reprojection error (pixels) above which a pose is not trusted: corners that no
-/// flat square explains (a misread, or a frame smeared by fast motion). Good poses sit
-/// well under a pixel.
-pub const MAX_POSE_ERROR_PX: f64 = 2.0;
-
 /// Around the tag's predicted place, the search region reaches this many tag widths beyond
 /// its corners: the tag's white margin and card (a quarter width) must be inside for the
 /// library to see the border, and the rest covers a change of speed between frames.
