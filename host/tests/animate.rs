@@ -364,31 +364,7 @@ fn strong_moves_wider_and_bends_lower_than_light() {
         // Amplitude: mean angle (rad) by which the arms' and legs' joints turn away from
         // their pose at the action's start — what eq. 7 scales. (Positions would mix in the
         // foot pinning, which holds planted feet whatever the amplitude.)
-        let amp = |a: &Assembly| {
-            let sk = &a.clip.skeleton;
-            let joints: Vec<usize> = [
-                "right_shoulder",
-                "right_elbow",
-                "left_shoulder",
-                "left_elbow",
-                "right_hip",
-                "right_knee",
-                "left_hip",
-                "left_knee",
-            ]
-            .iter()
-            .filter_map(|n| sk.find(n))
-            .collect();
-            let (s0, e0) = (a.placements[0].start_frame, a.placements[0].end_frame);
-            let q0 = &a.clip.frames[s0].rotations;
-            let mut sum = 0.0;
-            for f in s0..=e0 {
-                for &j in &joints {
-                    sum += q0[j].angle_between(a.clip.frames[f].rotations[j]);
-                }
-            }
-            sum / ((e0 - s0 + 1) * joints.len()) as f32
-        };
+        let amp = |a: &Assembly| a.limb_swing_rad(0).unwrap_or(0.0);
         // Spine angle at the action's first frame, where rescaling (eq. 7, anchored at the
         // stage start) has not acted yet, so the difference is the reshaping's alone.
         let tilt = |a: &Assembly| spine_lean(&a.clip, a.placements[0].start_frame, Vec3::X);

@@ -104,36 +104,9 @@ fn sidestep_steps_sideways_towards_the_doodle_with_alternating_feet() {
     panic!("seeds 1-12 never sidestep to both sides: {sides_seen:?}");
 }
 
-/// Mean angle (rad) by which the legs' and arms' joints turn away from their pose at the
-/// action's first frame: what effort's rescale (eq. 7) scales.
-fn amplitude(a: &Assembly) -> f32 {
-    let sk = &a.clip.skeleton;
-    let joints: Vec<usize> = [
-        "right_shoulder",
-        "right_elbow",
-        "left_shoulder",
-        "left_elbow",
-        "right_hip",
-        "right_knee",
-        "left_hip",
-        "left_knee",
-    ]
-    .iter()
-    .filter_map(|n| sk.find(n))
-    .collect();
-    let p = &a.placements[0];
-    let q0 = &a.clip.frames[p.start_frame].rotations;
-    let mut sum = 0.0;
-    for f in p.start_frame..=p.end_frame {
-        for &j in &joints {
-            sum += q0[j].angle_between(a.clip.frames[f].rotations[j]);
-        }
-    }
-    sum / ((p.end_frame - p.start_frame + 1) * joints.len()) as f32
-}
-
 #[test]
 fn sidestep_effort_stays_visible() {
+    let amplitude = |a: &Assembly| a.limb_swing_rad(0).unwrap_or(0.0);
     if !have_data() {
         return;
     }

@@ -167,6 +167,37 @@ pub struct Assembly {
     pub t_origin: f64,
 }
 
+impl Assembly {
+    /// How far an event's limbs swing (rad): the mean angle by which the arms' and legs' joints
+    /// turn away from their pose at the event's first frame, over its frames — what effort's
+    /// rescale (eq. 7) scales, and what tells a strong performance from a light one. `None`
+    /// without such a placement.
+    pub fn limb_swing_rad(&self, placement: usize) -> Option<f32> {
+        let sk = &self.clip.skeleton;
+        let joints: Vec<usize> = [
+            "right_shoulder",
+            "right_elbow",
+            "left_shoulder",
+            "left_elbow",
+            "right_hip",
+            "right_knee",
+            "left_hip",
+            "left_knee",
+        ]
+        .iter()
+        .filter_map(|n| sk.find(n))
+        .collect();
+        let p = self.placements.get(placement)?;
+        let q0 = &self.clip.frames.get(p.start_frame)?.rotations;
+        let frames = self.clip.frames.get(p.start_frame..=p.end_frame)?;
+        let sum: f32 = frames
+            .iter()
+            .flat_map(|f| joints.iter().map(|&j| q0[j].angle_between(f.rotations[j])))
+            .sum();
+        Some(sum / (frames.len() * joints.len()).max(1) as f32)
+    }
+}
+
 /// One placed action: its frames on the output clock.
 struct Placed {
     f0: usize,
