@@ -34,6 +34,17 @@ pub struct Leg {
     pub foot: Vec<usize>,
 }
 
+impl Leg {
+    /// The height (m) of the lowest point of the foot among world positions `world` (∞ when
+    /// none of its joints is there).
+    pub fn lowest_y(&self, world: &[Vec3]) -> f32 {
+        self.foot
+            .iter()
+            .filter_map(|&j| world.get(j).map(|p| p.y))
+            .fold(f32::INFINITY, f32::min)
+    }
+}
+
 /// Finds the legs of a skeleton from a clip's first frame (empty if none are found).
 pub fn find_legs(clip: &Clip) -> Vec<Leg> {
     let sk = &clip.skeleton;
@@ -97,11 +108,7 @@ pub fn detect_contacts(clip: &Clip, legs: &[Leg]) -> Vec<Vec<bool>> {
         .map(|leg| {
             (0..pos.len())
                 .map(|f| {
-                    let low = leg
-                        .foot
-                        .iter()
-                        .map(|&j| pos[f][j].y)
-                        .fold(f32::INFINITY, f32::min);
+                    let low = leg.lowest_y(&pos[f]);
                     let (a, b) = (f.saturating_sub(1), (f + 1).min(pos.len() - 1));
                     let d = pos[b][leg.ankle] - pos[a][leg.ankle];
                     let v = Vec3::new(d.x, 0.0, d.z).length() / ((b - a).max(1) as f32 * dt);
@@ -182,14 +189,7 @@ fn foot_heights(clip: &Clip, legs: &[Leg]) -> Vec<Vec<f32>> {
         .iter()
         .map(|p| {
             let world = clip.skeleton.positions(p);
-            legs.iter()
-                .map(|l| {
-                    l.foot
-                        .iter()
-                        .filter_map(|&j| world.get(j).map(|w| w.y))
-                        .fold(f32::INFINITY, f32::min)
-                })
-                .collect()
+            legs.iter().map(|l| l.lowest_y(&world)).collect()
         })
         .collect()
 }

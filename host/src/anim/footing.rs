@@ -95,11 +95,7 @@ pub fn clear_swing_feet(clip: &mut Clip, legs: &[Leg], contacts: &[Vec<bool>]) -
                 continue;
             }
             let world = sk.positions(pose);
-            let low = leg
-                .foot
-                .iter()
-                .filter_map(|&j| world.get(j).map(|p| p.y))
-                .fold(f32::INFINITY, f32::min);
+            let low = leg.lowest_y(&world);
             if low.is_nan() || low >= GROUND_Y + want {
                 continue;
             }
@@ -142,11 +138,7 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
             t.y += raise;
         }
         for leg in legs {
-            let low = leg
-                .foot
-                .iter()
-                .filter_map(|&j| before.get(j).map(|p| p.y))
-                .fold(f32::INFINITY, f32::min);
+            let low = leg.lowest_y(&before);
             // Only feet on the ground come back down, in frames whose legs had the slack (a
             // frame in need keeps its feet where the raise put them: on the ground).
             if low.is_nan() || low >= GROUND_Y + CONTACT_HEIGHT || need[f] > 0.0 {
@@ -156,7 +148,7 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
             // foot that would end below the ground stays where the raise put it instead.
             let kept = pose.rotations.clone();
             set_foot_height(&sk, pose, leg, low.max(GROUND_Y));
-            if lowest_point(&sk.positions(pose), leg) < GROUND_Y - SINK_TOLERANCE_M {
+            if leg.lowest_y(&sk.positions(pose)) < GROUND_Y - SINK_TOLERANCE_M {
                 pose.rotations = kept;
             }
         }
@@ -166,14 +158,6 @@ pub fn raise_evenly(clip: &mut Clip, legs: &[Leg], need: &[f32]) {
 /// How far below the ground (m) [`raise_evenly`] lets a foot it sets back down end (IK lands a
 /// foot within a fraction of a millimetre of its target when the leg has slack).
 const SINK_TOLERANCE_M: f32 = 1e-3;
-
-/// The height (m) of the lowest point of `leg`'s foot among world positions `world`.
-fn lowest_point(world: &[Vec3], leg: &Leg) -> f32 {
-    leg.foot
-        .iter()
-        .filter_map(|&j| world.get(j).map(|p| p.y))
-        .fold(f32::INFINITY, f32::min)
-}
 
 /// Moves the ankle of `leg` up or down by two-bone IK so that the foot's lowest point comes to
 /// height `y` (m), as near as the leg reaches (IK keeps the foot's orientation, so the ankle
@@ -185,11 +169,7 @@ fn set_foot_height(
     y: f32,
 ) {
     let world = sk.positions(pose);
-    let low = leg
-        .foot
-        .iter()
-        .filter_map(|&j| world.get(j).map(|p| p.y))
-        .fold(f32::INFINITY, f32::min);
+    let low = leg.lowest_y(&world);
     let off = low - y;
     let Some(&ankle) = world.get(leg.ankle) else {
         return;
