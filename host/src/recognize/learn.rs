@@ -739,7 +739,10 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             Regex::Cat(items)
         };
         if re.positions() <= budget {
-            if re.compile()?.min_len() == usize::MAX || re.compile()?.min_len() == 0 {
+            // (A pattern over the device's positions cannot be compiled; a caller that asked
+            // for one weighs its size itself.)
+            if re.positions() <= MAX_POSITIONS && matches!(re.compile()?.min_len(), 0 | usize::MAX)
+            {
                 bail!("learnt pattern accepts nothing useful");
             }
             return Ok(re);
@@ -768,8 +771,14 @@ fn simplify(alt: Regex) -> Regex {
 
 /// Learns a pattern that also accepts the mirror images (left ↔ right) of the examples: a
 /// figurine action done to the other side is the same action. When both sides do not fit the
-/// device together, optional groups are shed evenly, then rotation variants become wildcards
-/// ([`compact_rotations`]); only when even that does not fit is it the examples' own side.
+/// device together:
+///
+/// | the mirror images … | then |
+/// |---|---|
+/// | make the same strokes (a walk, a crouch: only the wobbles' signs differ) | one pattern is learnt from the examples and their mirror images together, when it fits whole |
+/// | make other strokes (a sidestep's `l` is `r`), or the joint pattern does not fit | each side sheds optional groups evenly, then rotation variants become wildcards ([`compact_rotations`]); only when even that does not fit is it the examples' own side |
+///
+/// A shed optional group loses the examples that needed it; a joint pattern loses none.
 pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     let direct = learn_regex(seqs)?;
     let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
@@ -784,6 +793,18 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     let both = Regex::Alt(vec![direct.clone(), mirror.clone()]);
     if both.positions() <= MAX_POSITIONS {
         return Ok(both);
+    }
+    if seqs
+        .iter()
+        .zip(&mirrored)
+        .all(|(a, b)| strokes(a) == strokes(b))
+    {
+        let joint: Vec<Tokenized> = seqs.iter().chain(&mirrored).cloned().collect();
+        if let Ok(re) = learn_regex_within(&joint, usize::MAX) {
+            if re.positions() <= MAX_POSITIONS && re.compile()?.min_len() != usize::MAX {
+                return Ok(re);
+            }
+        }
     }
     if let (Ok(d), Ok(m)) = (
         learn_regex_within(seqs, half),
@@ -801,6 +822,14 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     } else {
         Ok(direct)
     }
+}
+
+/// The translations (strokes) of a gesture's mandatory runs, in order (none for a pure turn).
+fn strokes(s: &Tokenized) -> Vec<u16> {
+    mandatory_runs(s)
+        .iter()
+        .map(|m| (m.0 & 0x3ff) / 27)
+        .collect()
 }
 
 /// `re` with every alternation of plain tokens that share one translation (`f.Zn|f|f.Zp`)
@@ -1260,6 +1289,34 @@ mod tests {
         ];
         let re = learn_regex(&seqs).unwrap();
         assert!(re.to_source().contains("l+"), "{}", re.to_source());
+    }
+
+    #[test]
+    fn a_gesture_that_is_its_own_mirror_image_is_learnt_from_both_sides_at_once() {
+        // Walks whose hops rock and roll one way and back: mirrored, they make the same
+        // strokes, and two sides with every example's optional runs do not fit the device.
+        let seqs = vec![
+            seq("uf:0.2 f.Zp:0.1 df.XnZp:0.2 .Zn:0.05 uf:0.2 f.Zn:0.1 df.XnZn:0.2 .Zp:0.05 uf:0.2 df:0.2"),
+            seq("uf.Zp:0.2 d.XnZp:0.05 df:0.2 u:0.05 uf:0.2 df.XpZp:0.2 .XnZn:0.05 uf:0.2 df.Zn:0.2"),
+            seq("uf:0.2 .Zp:0.05 df.Zp:0.2 ub:0.05 uf.Zn:0.2 f:0.05 df:0.2 .XnZp:0.05 uf:0.2 df:0.2 d:0.05"),
+        ];
+        let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
+        let sides = Regex::Alt(vec![
+            learn_regex_within(&seqs, usize::MAX).unwrap(),
+            learn_regex_within(&mirrored, usize::MAX).unwrap(),
+        ]);
+        assert!(sides.positions() > MAX_POSITIONS, "{}", sides.to_source());
+        let re = learn_regex_mirrored(&seqs).unwrap();
+        let c = re.compile().unwrap();
+        for s in seqs.iter().chain(&mirrored) {
+            let t = tokens_only(s);
+            assert!(
+                c.accepts(&t),
+                "{} rejects {}",
+                re.to_source(),
+                tokens_to_string(&t)
+            );
+        }
     }
 
     #[test]
