@@ -119,10 +119,12 @@ fn a_box_rig_is_tracked_at_every_heading_of_a_full_turn() {
 }
 
 #[test]
-fn a_fast_turn_never_takes_the_face_on_tag_s_mirror_pose() {
+fn a_fast_turn_stays_within_half_the_mirror_angle_at_every_frame() {
     // A turn of 120° at 3.5 rad/s, 0.6 m away: halfway, the left tag is square to the camera
     // and the front one edge-on, so for a few frames one flat square alone gives the pose,
-    // and its mirror (tilted the other way, ~22° off) fits its corners nearly as well.
+    // and its mirror (tilted the other way, ~22° off) fits its corners nearly as well. At
+    // this noise seed no frame takes the mirror (the old tie-break passed too: this bounds
+    // the chooser from doing worse; its own tests are in `track::mirror`).
     let turn = PoseLog {
         samples: (0..=240)
             .map(|i| {
