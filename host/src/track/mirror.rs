@@ -8,11 +8,12 @@
 //! pose on it (the negative log-likelihood under the corner noise, measured as the fits go)
 //! plus the cost of the turns between its poses (a toy does not turn by tens of degrees in a
 //! thirtieth of a second). A frame's fit counts in full only when the tag has moved since the
-//! last (a still tag shows the same biased picture again and again). Each frame reports the pose that ends the cheapest path — a forward
-//! Viterbi pass over the two branches. Near face-on the two poses are close, every path can
-//! reach both cheaply, and the costs merge; as they part, evidence builds up on the true side
-//! and the report follows it, a few frames after a wrong start at most, instead of holding
-//! the wrong tilt by continuity alone.
+//! last (a still tag shows the same biased picture again and again). Each frame reports the
+//! pose that ends the cheapest path — a forward Viterbi pass over the two branches. Near
+//! face-on the two poses are close, every path can reach both cheaply, and the costs merge; as
+//! they part, evidence builds up on the true side while the tag moves, and the report follows
+//! it instead of holding the wrong tilt by continuity alone. A tag that tilts and then holds
+//! still gives little evidence, and may keep the wrong tilt until it moves again.
 //!
 //! When several tags are in sight the pose has no mirror ([`super::fuse`]) and the branches
 //! collapse onto it ([`MirrorChooser::settle`]).
