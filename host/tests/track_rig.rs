@@ -119,6 +119,54 @@ fn a_box_rig_is_tracked_at_every_heading_of_a_full_turn() {
 }
 
 #[test]
+fn a_fast_turn_stays_within_half_the_mirror_angle_at_every_frame() {
+    // A turn of 120° at 3.5 rad/s, 0.6 m away: halfway, the left tag is square to the camera
+    // and the front one edge-on, so for a few frames one flat square alone gives the pose,
+    // and its mirror (tilted the other way, ~22° off) fits its corners nearly as well. At
+    // this noise seed no frame takes the mirror (the old tie-break passed too: this bounds
+    // the chooser from doing worse; its own tests are in `track::mirror`).
+    let turn = PoseLog {
+        samples: (0..=240)
+            .map(|i| {
+                let t = i as f64 / 240.0;
+                let q = DQuat::from_rotation_y(2.1 * ((t - 0.2) / 0.6).clamp(0.0, 1.0));
+                PoseSample {
+                    t,
+                    pos: [0.0, 0.0, -0.6],
+                    quat: [q.w, q.x, q.y, q.z],
+                }
+            })
+            .collect(),
+    };
+    let dir = scratch("rig-mirror");
+    let setup = Setup {
+        seed: 5,
+        rig_box: Some(BoxSize {
+            width: 0.08,
+            depth: 0.08,
+        }),
+        faults: Faults {
+            occlusion_every_s: 0.0,
+            ..Faults::default()
+        },
+        ..Setup::default()
+    };
+    let sc = scene(&setup, Family::Tag36h11, 0).unwrap();
+    let video = dir.join("turn.mp4");
+    let truths = render_video(&setup, &sc, &turn, &video).unwrap();
+    let run = track_video(&setup, Family::Tag36h11, 0, &video, Tracking::default()).unwrap();
+    let frames = compare(&truths, &run.log);
+    assert!(summarize(&frames).lost <= 2, "{:?}", summarize(&frames));
+    // Every frame within half the mirror's 22° of the truth.
+    let worst = frames
+        .iter()
+        .filter_map(|f| f.error.map(|e| (e.1, f.truth.t)))
+        .fold((0.0, 0.0), |a: (f64, f64), b| if b.0 > a.0 { b } else { a });
+    assert!(worst.0 < 11.0, "{:.1}° off at {:.2} s", worst.0, worst.1);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_cli_tracks_a_rig_prints_its_tags_and_refuses_bad_rigs() {
     let dir = scratch("rig-cli");
     // A turn of 120° to the left: the front tag hands over to the left one.
@@ -185,7 +233,8 @@ fn the_cli_tracks_a_rig_prints_its_tags_and_refuses_bad_rigs() {
         errs[errs.len() / 2] * 1e3
     );
     // Mid-turn (3.5 rad/s), with one tag square to the camera and the other edge-on, a frame
-    // or two take the face-on tag's mirror pose: 22° off, 15 mm at the box's centre.
+    // can still take the face-on tag's mirror pose (22° off, 15 mm at the box's centre) when
+    // its corners favour the mirror strongly two frames running.
     let worst = errs[errs.len() - 1];
     assert!(worst < 0.025, "worst {:.1} mm", worst * 1e3);
     // The rig's tags to print, each with its face.

@@ -1,18 +1,19 @@
 //! One figurine pose from every tag of the rig in sight.
 //!
-//! Each tag found is solved on its own ([`super::pnp::solve_pose`]) and carried to the body
-//! through its face's fixed place ([`super::rig::Face::body_from_tag`]). With one trusted tag
-//! that is the pose. With two or more, one pose is refined on all their corners together:
+//! Each tag found is solved on its own — both of its mirror poses
+//! ([`super::pnp::solve_candidates`]) — and carried to the body through its face's fixed place
+//! ([`super::rig::Face::body_from_tag`]). With one trusted tag those are the candidates, and
+//! [`super::mirror`] picks one over time. With two or more, one pose is refined on all their corners together:
 //! points on two planes at an angle admit no mirror pose, and the steeper tag — whose
 //! foreshortening shows its tilt by whole pixels — pins the orientation that a face-on tag
-//! reads only from hundredths of a pixel. The refinement starts from each tag's own pose and
-//! keeps the best fit; when even that fits badly (the tags disagree: a misread, a rig measured
+//! reads only from hundredths of a pixel. The refinement starts from each tag's poses, mirrors
+//! included, and keeps the best fit; when even that fits badly (the tags disagree: a misread, a rig measured
 //! wrong) the largest tag in the picture is trusted alone.
 
-use glam::{DQuat, DVec2, DVec3};
+use glam::{DVec2, DVec3};
 
 use super::detect::{CameraPose, Detection, Intrinsics};
-use super::pnp::{refine, solve_pose};
+use super::pnp::{refine, solve_candidates};
 use super::rig::Rig;
 
 /// RMS corner reprojection error (pixels) above which a pose is not trusted: corners that no
@@ -25,10 +26,14 @@ pub const MAX_POSE_ERROR_PX: f64 = 2.0;
 pub struct TagSeen {
     /// What the detector found.
     pub detection: Detection,
-    /// The tag's own camera-frame pose (trusted or not: see its error).
+    /// The tag's own camera-frame pose that fits its corners best (trusted or not: see its
+    /// error).
     pub tag: CameraPose,
-    /// The body's camera-frame pose this tag alone gives.
+    /// The body's camera-frame pose this tag alone gives (from [`Self::tag`]).
     pub body: CameraPose,
+    /// Every body pose the tag admits — its best fit and, when it differs, its mirror — each
+    /// with the tag's RMS corner error (pixels), the best first.
+    pub candidates: Vec<CameraPose>,
 }
 
 impl TagSeen {
@@ -50,37 +55,55 @@ impl TagSeen {
     }
 }
 
-/// Solves every detection of a rig tag; `last_body` (the body's last tag-convention rotation
-/// in the camera frame) breaks each tag's near-ties between its two mirror poses.
-pub fn solve_tags(
-    rig: &Rig,
-    found: Vec<Detection>,
-    k: &Intrinsics,
-    last_body: Option<DQuat>,
-) -> Vec<TagSeen> {
+/// Solves every detection of a rig tag: both of its mirror poses, carried to the body.
+pub fn solve_tags(rig: &Rig, found: Vec<Detection>, k: &Intrinsics) -> Vec<TagSeen> {
     found
         .into_iter()
         .filter_map(|d| {
             let face = rig.face(d.id)?;
-            let previous = last_body.map(|b| face.tag_rotation(b));
-            let tag = solve_pose(&d.corners, rig.tag_size, k, previous)?;
-            let body = face.body_from_tag(&tag);
+            let tags = solve_candidates(&d.corners, rig.tag_size, k);
+            let tag = *tags.first()?;
+            let candidates: Vec<CameraPose> = tags
+                .iter()
+                .filter(|c| c.error <= MAX_POSE_ERROR_PX || c.error == tag.error)
+                .map(|c| face.body_from_tag(c))
+                .collect();
             Some(TagSeen {
                 detection: d,
                 tag,
-                body,
+                body: candidates[0],
+                candidates,
             })
         })
         .collect()
 }
 
+/// The body's pose from one frame's tags.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Fused {
+    /// Two or more tags agreed on one pose: points on two planes admit no mirror.
+    Settled(CameraPose),
+    /// One tag is trusted (or the tags disagree and the largest is trusted alone): the body
+    /// poses it admits, the best fit first; which to report is decided over time
+    /// ([`super::mirror`]).
+    Lone {
+        /// The body poses, each with the tag's RMS corner error (pixels).
+        candidates: Vec<CameraPose>,
+        /// The tag's corners, pixels.
+        corners: [[f64; 2]; 4],
+    },
+}
+
 /// The body's pose from the tags seen: `None` when no tag is trusted.
-pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<CameraPose> {
+pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<Fused> {
     let trusted: Vec<&TagSeen> = seen.iter().filter(|s| s.trusted()).collect();
     let largest = trusted
         .iter()
         .max_by(|a, b| a.area_px().total_cmp(&b.area_px()))
-        .map(|s| s.body)?;
+        .map(|s| Fused::Lone {
+            candidates: s.candidates.clone(),
+            corners: s.detection.corners,
+        })?;
     if trusted.len() < 2 {
         return Some(largest);
     }
@@ -90,18 +113,21 @@ pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<CameraPose> {
         obj.extend(face.corners_in_body(rig.tag_size));
         px.extend(s.detection.corners.map(|c| DVec2::new(c[0], c[1])));
     }
+    // Every tag's poses, mirrors included, as starting points: the joint fit has one
+    // minimum worth having, and one of them lies in its basin.
     let best = trusted
         .iter()
-        .map(|s| {
-            let (q, t) = (s.body.quat(), DVec3::from_array(s.body.translation));
+        .flat_map(|s| &s.candidates)
+        .map(|c| {
+            let (q, t) = (c.quat(), DVec3::from_array(c.translation));
             refine(q, t, &obj, &px, k)
         })
         .filter(|(q, t, err)| q.is_finite() && t.is_finite() && err.is_finite())
         .min_by(|a, b| a.2.total_cmp(&b.2));
     match best {
-        Some((q, t, err)) if err <= MAX_POSE_ERROR_PX => {
-            Some(CameraPose::from_parts(glam::DMat3::from_quat(q), t, err))
-        }
+        Some((q, t, err)) if err <= MAX_POSE_ERROR_PX => Some(Fused::Settled(
+            CameraPose::from_parts(glam::DMat3::from_quat(q), t, err),
+        )),
         _ => Some(largest),
     }
 }
@@ -110,6 +136,7 @@ pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<CameraPose> {
 mod tests {
     use super::*;
     use crate::track::pose::{angle_between_deg, camera_pose, figurine_pose, intrinsics_from_fov};
+    use glam::DQuat;
 
     /// The detections a perfect detector would give of the rig's tags turned toward the
     /// camera (more than 10° from edge-on), the corners shifted by `jitter(i)` pixels.
@@ -158,17 +185,15 @@ mod tests {
         let jitter = |i: usize| 0.15 * ((i * 7919 % 13) as f64 / 6.0 - 1.0);
         let found = seen(&rig, p, q, &k, jitter);
         assert_eq!(found.iter().map(|d| d.id).collect::<Vec<_>>(), [0, 1]);
-        let tags = solve_tags(
-            &rig,
-            found,
-            &k,
-            Some(DQuat::from_mat3(&camera_pose(p, q).0)),
-        );
+        let tags = solve_tags(&rig, found, &k);
         let err = |c: &CameraPose| {
             let (p2, q2) = figurine_pose(c);
             ((p2 - p).length() * 1000.0, angle_between_deg(q, q2))
         };
-        let fused = err(&fuse(&rig, &tags, &k).unwrap());
+        let Some(Fused::Settled(both)) = fuse(&rig, &tags, &k) else {
+            panic!("two tags in sight give one settled pose");
+        };
+        let fused = err(&both);
         for t in &tags {
             let one = err(&t.body);
             assert!(

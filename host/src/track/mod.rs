@@ -15,6 +15,7 @@ pub mod cli;
 pub mod detect;
 pub mod eval;
 pub mod fuse;
+pub mod mirror;
 pub mod pnp;
 pub mod pose;
 pub mod print;

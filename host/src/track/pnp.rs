@@ -193,6 +193,34 @@ fn mirrored(q: DQuat, t: DVec3) -> Option<DQuat> {
     Some((turn * q).normalize())
 }
 
+/// Both poses a flat square's corners admit (pixels, detector order; edge `size` metres): the
+/// homography's, refined, and its mirror about the line of sight, refined — the better fit
+/// first, each with its RMS corner reprojection error in pixels. One pose when the mirror
+/// does not exist (a tag square to the line of sight through its centre) or failed.
+pub fn solve_candidates(corners: &[[f64; 2]; 4], size: f64, k: &Intrinsics) -> Vec<CameraPose> {
+    let obj = object_corners(size);
+    let px: [DVec2; 4] = corners.map(|c| DVec2::new(c[0], c[1]));
+    let norm = px.map(|p| DVec2::new((p.x - k.cx) / k.fx, (p.y - k.cy) / k.fy));
+    let Some((q0, t0)) = homography(&obj, &norm).and_then(pose_from_homography) else {
+        return Vec::new();
+    };
+    let first = refine(q0, t0, &obj, &px, k);
+    let second = mirrored(first.0, first.1).map(|qm| refine(qm, first.1, &obj, &px, k));
+    let mut out: Vec<CameraPose> = [Some(first), second]
+        .into_iter()
+        .flatten()
+        .filter(|(q, t, err)| err.is_finite() && t.is_finite() && q.is_finite())
+        .map(|(q, t, err)| CameraPose::from_parts(DMat3::from_quat(q), t, err))
+        .collect();
+    out.sort_by(|a, b| a.error.total_cmp(&b.error));
+    // Both refinements may settle in the same pose (far from face-on the mirror's basin
+    // drains into the true one): one answer, not two.
+    if out.len() == 2 && out[0].quat().dot(out[1].quat()).abs() > 1.0 - 1e-9 {
+        out.truncate(1);
+    }
+    out
+}
+
 /// The tag's pose from its corners (pixels, detector order), its edge `size` (metres) and the
 /// camera; `previous` (the last tag→camera rotation) breaks near ties. The error is the RMS
 /// corner reprojection error in pixels.
@@ -202,33 +230,17 @@ pub fn solve_pose(
     k: &Intrinsics,
     previous: Option<DQuat>,
 ) -> Option<CameraPose> {
-    let obj = object_corners(size);
-    let px: [DVec2; 4] = corners.map(|c| DVec2::new(c[0], c[1]));
-    let norm = px.map(|p| DVec2::new((p.x - k.cx) / k.fx, (p.y - k.cy) / k.fy));
-    let h = homography(&obj, &norm)?;
-    let (q0, t0) = pose_from_homography(h)?;
-    let mut best = refine(q0, t0, &obj, &px, k);
-    if let Some(qm) = mirrored(best.0, best.1) {
-        let alt = refine(qm, best.1, &obj, &px, k);
-        let (lo, hi) = if alt.2 < best.2 {
-            (alt, best)
-        } else {
-            (best, alt)
-        };
-        best = lo;
-        if hi.2 <= lo.2 * TIE_FACTOR + TIE_PX {
-            if let Some(prev) = previous {
-                if hi.0.dot(prev).abs() > lo.0.dot(prev).abs() {
-                    best = hi;
-                }
-            }
+    let both = solve_candidates(corners, size, k);
+    let (lo, hi) = (both.first()?, both.get(1));
+    match (hi, previous) {
+        (Some(hi), Some(prev))
+            if hi.error <= lo.error * TIE_FACTOR + TIE_PX
+                && hi.quat().dot(prev).abs() > lo.quat().dot(prev).abs() =>
+        {
+            Some(*hi)
         }
+        _ => Some(*lo),
     }
-    let (q, t, err) = best;
-    if !(err.is_finite() && t.is_finite()) {
-        return None;
-    }
-    Some(CameraPose::from_parts(DMat3::from_quat(q), t, err))
 }
 
 #[cfg(test)]

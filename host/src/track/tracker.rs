@@ -13,7 +13,8 @@
 use glam::{DQuat, DVec3};
 
 use super::detect::{CameraPose, Detection, Detector, GrayFrame, Intrinsics, Region};
-use super::fuse::{fuse, solve_tags};
+use super::fuse::{fuse, solve_tags, Fused};
+use super::mirror::MirrorChooser;
 use super::pose::{figurine_pose, project};
 use super::rig::Rig;
 use super::smooth::OrientationFilter;
@@ -31,6 +32,12 @@ pub const MIN_SEARCH_MARGIN_PX: f64 = 16.0;
 /// The region search is tried only when the tag was seen within this many seconds; after a
 /// longer gap the tag may be anywhere and the whole frame is searched.
 pub const MAX_SEARCH_GAP_S: f64 = 0.1;
+
+/// A tag last seen narrower than this (its longest side, pixels) and not found near its last
+/// place is looked for there again in the picture enlarged
+/// ([`Detector::detect_in_enlarged`]) before the whole frame is searched: at 1 m a 4 cm tag
+/// turned 45° is ~15 px wide, cells of 1.5 px, at the library's limit.
+pub const SMALL_TAG_PX: f64 = 32.0;
 
 /// Where the rig was last seen, for searching near it first.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,8 +59,8 @@ pub struct Tracker {
     rig: Rig,
     intrinsics: Intrinsics,
     last: Option<DQuat>,
-    /// The body's last trusted rotation in the camera frame (tag convention).
-    last_body: Option<DQuat>,
+    /// Which of a lone tag's mirror poses to report, decided over frames.
+    mirror: MirrorChooser,
     smooth: Option<OrientationFilter>,
     seen: Option<Seen>,
     search_near: bool,
@@ -89,7 +96,7 @@ impl Tracker {
             rig,
             intrinsics,
             last: None,
-            last_body: None,
+            mirror: MirrorChooser::default(),
             smooth: None,
             seen: None,
             search_near: true,
@@ -125,12 +132,26 @@ impl Tracker {
         let mut found = near
             .map(|r| clearest(&self.rig, self.detector.detect_in(frame, r)))
             .unwrap_or_default();
+        let small = self.seen.as_ref().is_some_and(|s| s.side < SMALL_TAG_PX);
+        if let Some(r) = near.filter(|_| found.is_empty() && small) {
+            found = clearest(&self.rig, self.detector.detect_in_enlarged(frame, r));
+        }
         if found.is_empty() {
             found = clearest(&self.rig, self.detector.detect(frame));
         }
         let k = self.intrinsics;
-        let tags = solve_tags(&self.rig, found.clone(), &k, self.last_body);
-        let fused = fuse(&self.rig, &tags, &k);
+        let tags = solve_tags(&self.rig, found.clone(), &k);
+        let fused = match fuse(&self.rig, &tags, &k) {
+            Some(Fused::Settled(pose)) => {
+                self.mirror.settle(t, &pose);
+                Some(pose)
+            }
+            Some(Fused::Lone {
+                candidates,
+                corners,
+            }) => self.mirror.choose(t, &candidates, &corners),
+            None => None,
+        };
         let largest = tags
             .iter()
             .max_by(|a, b| a.area_px().total_cmp(&b.area_px()));
@@ -139,7 +160,6 @@ impl Tracker {
             .or_else(|| found.first().cloned());
         self.remember(t, &found, fused.as_ref());
         let sample = fused.as_ref().map(|pose| {
-            self.last_body = Some(pose.quat());
             let (p, mut q) = figurine_pose(pose);
             if let Some(f) = &mut self.smooth {
                 q = f.push(t, q);
@@ -380,7 +400,7 @@ mod tests {
         let r = tr.frame(0.0, &frame);
         let ids: Vec<u32> = r.detections.iter().map(|d| d.id).collect();
         assert_eq!(ids, [0, 1], "the front and the left tag");
-        let tags = solve_tags(&rig, r.detections.clone(), &s.intrinsics, None);
+        let tags = solve_tags(&rig, r.detections.clone(), &s.intrinsics);
         let poses: Vec<_> = tags.iter().map(|t| figurine_pose(&t.body)).collect();
         let apart = (poses[0].0 - poses[1].0).length() * 1000.0;
         let turn = angle_between_deg(poses[0].1, poses[1].1);
