@@ -14,6 +14,7 @@ pub(crate) struct TileLog {
     pub(crate) pairs: f64,
     pub(crate) read_s: f64,
     pub(crate) search_s: f64,
+    pub(crate) search_cpu: f64,
     pub(crate) write_s: f64,
     pub(crate) cpu_s: f64,
     pub(crate) peak_mib: f64,
@@ -48,20 +49,28 @@ pub(crate) fn tile_log(job: &Path, i: usize) -> Result<TileLog> {
         pairs,
         field("read "),
         field("search "),
+        field("search cpu "),
         field("write "),
-        field("cpu "),
+        field(", cpu "),
         field("peak "),
     ) {
-        (Some(pairs), Some(read_s), Some(search_s), Some(write_s), Some(cpu_s), Some(peak_mib)) => {
-            Ok(TileLog {
-                pairs,
-                read_s,
-                search_s,
-                write_s,
-                cpu_s,
-                peak_mib,
-            })
-        }
+        (
+            Some(pairs),
+            Some(read_s),
+            Some(search_s),
+            Some(search_cpu),
+            Some(write_s),
+            Some(cpu_s),
+            Some(peak_mib),
+        ) => Ok(TileLog {
+            pairs,
+            read_s,
+            search_s,
+            search_cpu,
+            write_s,
+            cpu_s,
+            peak_mib,
+        }),
         _ => bail!("{}: no figures in `{t}`", path.display()),
     }
 }

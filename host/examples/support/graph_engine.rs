@@ -93,6 +93,7 @@ struct Built {
     load: f64,
     lma: f64,
     posture: f64,
+    posture_cpu: f64,
     style: f64,
     cpu: f64,
     peak: f64,
@@ -117,8 +118,9 @@ fn build_cli(exe: &Path, lib: &Path, out: &Path) -> Result<Built> {
         load: number_after(&text, "load ")?,
         lma: number_after(&text, ", LMA ")?,
         posture: number_after(&text, "posture ")?,
+        posture_cpu: number_after(&text, "posture cpu ")?,
         style: number_after(&text, "style ")?,
-        cpu: number_after(&text, "cpu ")?,
+        cpu: number_after(&text, ", cpu ")?,
         peak: number_after(&text, "peak ")?,
         local_minima: word_after(&text, "window pairs, ")?.parse()?,
         edges: word_after(&text, "MG ")?.parse()?,
@@ -254,18 +256,18 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
     let runs = runs.max(1);
     for rep in 0..runs {
         let built_path = dir.join("build.bin");
-        let b = build_cli(&exe, &lib, &built_path)?;
-        let (build_s, build_cpu) = (b.wall, b.cpu);
+        let bl = build_cli(&exe, &lib, &built_path)?;
+        let (build_s, build_cpu) = (bl.wall, bl.cpu);
         let built = std::fs::read(&built_path)?;
-        (minima, edges) = (b.local_minima, b.edges);
+        (minima, edges) = (bl.local_minima, bl.edges);
         println!(
             "{}figurine graph build, {n} frames: {build_s:.2} s, cpu {build_cpu:.2} s (load {:.2} s, LMA {:.2} s, posture {:.2} s, style {:.2} s), peak {:.0} MiB; {minima} local maxima, {edges} MG edges",
             if runs > 1 { format!("run {}/{runs}: ", rep + 1) } else { String::new() },
-            b.load,
-            b.lma,
-            b.posture,
-            b.style,
-            b.peak,
+            bl.load,
+            bl.lma,
+            bl.posture,
+            bl.style,
+            bl.peak,
         );
         let Some(cluster) = &cluster else {
             std::fs::remove_dir_all(&dir).ok();
@@ -280,6 +282,15 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
             let r = engine_run(cluster, &lib, band, via_srun, &exe, &dir, &built)?;
             let row = Row::of(&r, build_s, build_cpu);
             row.print(&label(job), r.tiles.len());
+            // The same kernel tiles in both: wall and CPU of the tiles' searches against the
+            // build's posture stage.
+            println!(
+                "        search: tiles {:.2} s, cpu {:.2} s; graph build's posture {:.2} s, cpu {:.2} s",
+                r.tiles.iter().map(|t| t.search_s).sum::<f64>(),
+                r.tiles.iter().map(|t| t.search_cpu).sum::<f64>(),
+                bl.posture,
+                bl.posture_cpu,
+            );
             tiles_of[b] = r.tiles.len();
             let k = r.tiles.len() as f64;
             let tiles_cpu: f64 = r.tiles.iter().map(|t| t.cpu_s).sum();

@@ -146,10 +146,11 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         scc(Variant::Lma)
     );
     println!(
-        "time: load {:.2} s, LMA {:.2} s, posture {:.2} s, style {:.2} s, total {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+        "time: load {:.2} s, LMA {:.2} s, posture {:.2} s (posture cpu {:.2} s), style {:.2} s, total {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
         load_seconds,
         st.lma_seconds,
         st.posture_seconds,
+        st.posture_cpu_seconds,
         st.style_seconds,
         t0.elapsed().as_secs_f64(),
         cpu_seconds().unwrap_or(f64::NAN),

@@ -134,13 +134,14 @@ pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
 pub(super) fn tile_cmd(a: TileArgs) -> anyhow::Result<()> {
     let r = run_tile(&a.job, a.index, !a.quiet)?;
     println!(
-        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.3} s, search {:.3} s, write {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.3} s, search {:.3} s (search cpu {:.2} s), write {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
         a.index,
         r.kernels,
         r.found.pairs,
         r.found.candidates.len(),
         r.read_seconds,
         r.search_seconds,
+        r.search_cpu_seconds,
         r.write_seconds,
         cpu_seconds().unwrap_or(f64::NAN),
         peak_memory_mib().unwrap_or(f64::NAN),
