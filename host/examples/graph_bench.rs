@@ -6,14 +6,17 @@
 //! table; `… -- FRAMES` runs one size. Needs the data of `cargo xtask setup` (or
 //! FIGURINE_DATA_DIR).
 //!
-//! `… -- engine` compares `graph build` with the same job planned, run as a Slurm job array on
-//! a single-node cluster started for it (see `tests/support/slurm.rs`; needs root and the
-//! `slurm-wlm` and `munge` packages) and merged: 54k frames in 10, 3 and 1 tiles, three runs
-//! (medians printed), then 108k frames once. It prints the engine's overhead, its stages from
-//! plan to graph, time and memory per tile, merge time and memory, the feature store's size,
-//! and a scale model for 4 M frames. `… -- engine FRAMES RUNS BAND…` runs one library size
-//! with the given bands (frames) RUNS times. It needs the release `figurine` binary beside the
-//! examples folder (`cargo build --release -p figurine-host --bin figurine`).
+//! `… -- engine` writes the library as BVH files and compares `figurine graph build` on them
+//! with the same job run through Slurm on a single-node cluster started for it (see
+//! `tests/support/slurm.rs`; needs root and the `slurm-wlm` and `munge` packages): planned
+//! outside Slurm and submitted with `submit.sh` ("sbatch"), and planned by `srun figurine graph
+//! plan … --submit` ("srun"), each a job array of tiles and a dependent merge. 54k frames in
+//! 10, 3 and 1 tiles, three runs (medians printed), then 108k frames once. It prints the
+//! engine's overhead, its stages from plan to graph, time and memory per tile, merge time and
+//! memory, the feature store's size, and a scale model for 4 M frames. `… -- engine FRAMES
+//! RUNS BAND…` runs one library size with the given bands (frames) RUNS times. It needs the
+//! release `figurine` binary beside the examples folder (`cargo build --release -p
+//! figurine-host --bin figurine`).
 
 use std::process::Command;
 use std::time::Instant;

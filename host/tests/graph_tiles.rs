@@ -179,6 +179,66 @@ fn slurm_job_array_and_dependent_merge_equal_the_build() {
         merged == built,
         "graph from the Slurm job differs from graph build"
     );
+
+    // The plan as a Slurm job step that submits the job itself: the tile array depends on the
+    // plan's job, so slurmctld starts it when that job ends.
+    let job2 = dir.join("job2");
+    let mut args = vec![
+        "-c1",
+        "--job-name=figurine-plan",
+        env!("CARGO_BIN_EXE_figurine"),
+        "graph",
+        "plan",
+        dm.to_str().unwrap(),
+        "--out",
+        job2.to_str().unwrap(),
+        "--band",
+        BAND,
+        "--cpus-per-task",
+        "1",
+        "--submit",
+        "--quiet",
+    ];
+    args.extend(OPTS);
+    let out = cluster.command("srun").args(&args).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let after = |key: &str| {
+        text.split(key)
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .unwrap_or_else(|| panic!("no `{key}` in: {text}"))
+            .to_string()
+    };
+    let (plan_id, tiles_id, merge_id) = (
+        after("when Slurm job "),
+        after("tiles: job "),
+        after("merge: job "),
+    );
+    let state = cluster
+        .wait_job(&merge_id, Duration::from_secs(120))
+        .unwrap();
+    assert_eq!(state, "COMPLETED", "{text}");
+    assert!(
+        std::fs::read(job2.join("graph.bin")).unwrap() == built,
+        "graph from the srun-planned job differs from graph build"
+    );
+    // slurmctld's log: the plan's job ended before the first tile task was allocated.
+    let log = std::fs::read_to_string(cluster.controller_log()).unwrap();
+    let line_of = |needle: &str| {
+        log.lines()
+            .position(|l| l.contains(needle))
+            .unwrap_or_else(|| panic!("no `{needle}` in slurmctld's log"))
+    };
+    assert!(
+        line_of(&format!("_job_complete: JobId={plan_id} done"))
+            < line_of(&format!("sched: Allocate JobId={tiles_id}_")),
+        "the tiles started before the plan's job ended"
+    );
     drop(cluster);
     std::fs::remove_dir_all(&dir).ok();
 }

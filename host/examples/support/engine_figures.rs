@@ -14,6 +14,7 @@ pub(crate) struct TileLog {
     pub(crate) pairs: f64,
     pub(crate) read_s: f64,
     pub(crate) search_s: f64,
+    pub(crate) search_cpu: f64,
     pub(crate) write_s: f64,
     pub(crate) cpu_s: f64,
     pub(crate) peak_mib: f64,
@@ -48,20 +49,28 @@ pub(crate) fn tile_log(job: &Path, i: usize) -> Result<TileLog> {
         pairs,
         field("read "),
         field("search "),
+        field("search cpu "),
         field("write "),
-        field("cpu "),
+        field(", cpu "),
         field("peak "),
     ) {
-        (Some(pairs), Some(read_s), Some(search_s), Some(write_s), Some(cpu_s), Some(peak_mib)) => {
-            Ok(TileLog {
-                pairs,
-                read_s,
-                search_s,
-                write_s,
-                cpu_s,
-                peak_mib,
-            })
-        }
+        (
+            Some(pairs),
+            Some(read_s),
+            Some(search_s),
+            Some(search_cpu),
+            Some(write_s),
+            Some(cpu_s),
+            Some(peak_mib),
+        ) => Ok(TileLog {
+            pairs,
+            read_s,
+            search_s,
+            search_cpu,
+            write_s,
+            cpu_s,
+            peak_mib,
+        }),
         _ => bail!("{}: no figures in `{t}`", path.display()),
     }
 }
@@ -72,15 +81,19 @@ pub(crate) struct EngineRun {
     pub(crate) tiles: Vec<TileLog>,
     /// The merge task's log.
     pub(crate) merge_log: String,
-    /// Plan wall seconds, of which computing features and writing the store and manifest.
+    /// Wall seconds of `srun figurine graph plan … --submit`, from its start to its return.
+    pub(crate) srun_s: f64,
+    /// The plan's own wall seconds (before submitting), of which loading the clips, computing
+    /// features and writing the store and manifest.
     pub(crate) plan_s: f64,
+    pub(crate) load_s: f64,
     pub(crate) features_s: f64,
     pub(crate) write_s: f64,
     /// Plan CPU seconds.
     pub(crate) plan_cpu: f64,
-    /// Wall seconds of `submit.sh` (two sbatch calls).
+    /// Wall seconds of `submit.sh` (two sbatch calls) inside the plan.
     pub(crate) submit_s: f64,
-    /// Wall seconds from plan to the merged graph file.
+    /// Wall seconds from `srun` to the merged graph file.
     pub(crate) wall: f64,
     /// Feature store size, bytes.
     pub(crate) store: u64,
@@ -117,17 +130,25 @@ impl Row {
         let merge_cpu = after(&r.merge_log, "cpu ").unwrap_or(f64::NAN);
         let sum = |f: fn(&TileLog) -> f64| r.tiles.iter().map(f).sum::<f64>();
         let mut stages = vec![
+            ("plan: load", r.load_s),
             ("plan: features", r.features_s),
             ("plan: store + manifest", r.write_s),
-            ("plan: scripts", r.plan_s - r.features_s - r.write_s),
+            (
+                "plan: scripts",
+                r.plan_s - r.load_s - r.features_s - r.write_s,
+            ),
             ("submit.sh", r.submit_s),
+            (
+                "srun: plan step start + end",
+                r.srun_s - r.plan_s - r.submit_s,
+            ),
         ];
         match &r.slurm {
             Some(s) => {
                 let in_slurm: f64 = s.task_runs.iter().sum();
                 let merge_slurm = s.merge_run;
                 stages.extend([
-                    ("Slurm: to the first task", s.first_start),
+                    ("Slurm: plan's end to the first task", s.first_start),
                     ("tiles: read", sum(|t| t.read_s)),
                     ("tiles: search", sum(|t| t.search_s)),
                     ("tiles: write", sum(|t| t.write_s)),
@@ -149,10 +170,11 @@ impl Row {
                             - after(&r.merge_log, "style ").unwrap_or(f64::NAN),
                     ),
                     ("Slurm: merge start + end", merge_slurm - merge),
-                    // What the other stages leave: the graph file appears a few hundredths
-                    // of a second before slurmctld logs the merge's end, so this is
-                    // slightly negative when nothing else is lost.
-                    ("rest", r.wall - r.plan_s - r.submit_s - s.span),
+                    // What the other stages leave: srun returns a few hundredths of a second
+                    // after slurmctld logs the plan job's end, and the graph file appears a few
+                    // hundredths before it logs the merge's, so this is about zero when
+                    // nothing else is lost.
+                    ("rest", r.wall - r.srun_s - s.span),
                 ]);
             }
             None => stages.push(("Slurm log unread", f64::NAN)),
@@ -161,8 +183,8 @@ impl Row {
             wall: r.wall,
             build,
             build_cpu,
-            plan: r.plan_s,
-            gap: (r.wall - r.plan_s - work - merge) / (k + 1.0),
+            plan: r.srun_s,
+            gap: (r.wall - r.plan_s - r.submit_s - work - merge) / (k + 1.0),
             cpu: r.plan_cpu + tile_cpu + merge_cpu,
             tile_mean: work / k,
             tile_max: r.tiles.iter().map(TileLog::wall).fold(0.0, f64::max),
@@ -205,7 +227,7 @@ impl Row {
 
     pub(crate) fn print(&self, label: &str, tiles: usize) {
         println!(
-            "{label:>6} {tiles:>5} | {:>7.2} {:>6.2} {:>8.2} {:>5.0}% {:>6.2} | {:>7.2} {:>5.0}% | {:>6.2} {:>6.2} {:>6.2} {:>5.0} | {:>7.2} {:>6.2} {:>5.0}",
+            "{label:>12} {tiles:>5} | {:>7.2} {:>6.2} {:>8.2} {:>5.0}% {:>6.2} | {:>7.2} {:>5.0}% | {:>6.2} {:>6.2} {:>6.2} {:>5.0} | {:>7.2} {:>6.2} {:>5.0}",
             self.build,
             self.plan,
             self.wall,

@@ -1,25 +1,25 @@
-//! `graph_bench engine`: the same library built by `graph build` and by a Slurm job array of
-//! `graph tile` tasks with a dependent `graph merge`, on a single-node cluster started here.
+//! `graph_bench engine`: the same library built by `figurine graph build` and by the engine
+//! path on a single-node Slurm cluster started here: `srun figurine graph plan … --submit` (the
+//! plan as a job step, which submits a job array of `graph tile` tasks that waits for it, and a
+//! dependent `graph merge`). Both are the CLI a user runs, on the same BVH files (the library is
+//! written to a folder first), so both include loading the clips and starting processes.
 //!
-//! Two overheads are printed: wall time (plan to merged graph file, against the build's) and
-//! CPU time (plan + every tile + merge, against the build's). On a machine shared with other
-//! work wall time also measures the neighbours; CPU time measures what the split itself costs,
-//! and the gap (wall time neither plan, tile nor merge, per task) is what Slurm adds. Each run
-//! also prints its stages from plan to graph: the plan's, each tile's and the merge's own
-//! timings (from their log lines) and Slurm's (from slurmctld's log: submission, allocation
-//! and completion of every task), so that where the time goes is measured, not guessed. With
-//! several runs, the medians follow. The scale model uses CPU time per window pair divided by
-//! the cores of a task.
+//! Two overheads are printed: wall time (`srun` to the merged graph file, against the build
+//! command's) and CPU time (plan + every tile + merge, against the build's). On a machine shared
+//! with other work wall time also measures the neighbours; CPU time measures what the split
+//! itself costs, and the gap (wall time neither plan, tile nor merge, per task) is what Slurm
+//! adds. Each run also prints its stages from plan to graph: the plan's, each tile's and the
+//! merge's own timings (from their output) and Slurm's (from slurmctld's log: the plan job's
+//! allocation and end, each task's allocation and completion, the merge's), so that where the
+//! time goes is measured, not guessed. With several runs, the medians follow. The scale model
+//! uses CPU time per window pair divided by the cores of a task.
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use figurine_host::graph::build::BuildStats;
-use figurine_host::graph::plan::plan_job;
-use figurine_host::graph::slurm::write_scripts;
 use figurine_host::graph::store::BYTES_PER_FRAME;
-use figurine_host::graph::{build_graph, BuildParams};
-use figurine_host::graph::{cpu_seconds, peak_memory_mib, GraphClip, Variant};
+use figurine_host::graph::GraphClip;
+use figurine_host::motion::write_bvh_path;
 
 use crate::figures::{after, tile_log, EngineRun, Row};
 use crate::slurm_log::timeline;
@@ -60,12 +60,82 @@ fn wait_for_graph(cluster: &Cluster, merge_id: &str, graph: &Path, job: &Path) -
     Ok(())
 }
 
-/// One engine run of `clips` with bands of `band` frames; checks the merged bytes against
-/// `built`.
+/// Runs `figurine ARGS…` (or `cmd` as given) and returns its stdout; fails with its output.
+fn run_out(cmd: &mut std::process::Command) -> Result<String> {
+    let out = cmd.output()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !out.status.success() {
+        bail!(
+            "{cmd:?} failed: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    Ok(text)
+}
+
+/// The word after `key` in `text`.
+fn word_after(text: &str, key: &str) -> Result<String> {
+    text.split(key)
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .map(|w| w.trim_end_matches([',', ';']).to_string())
+        .with_context(|| format!("no `{key}` in: {text}"))
+}
+
+/// The number after `key` in `text`, or an error quoting it.
+fn number_after(text: &str, key: &str) -> Result<f64> {
+    after(text, key).with_context(|| format!("no `{key}` figure in: {text}"))
+}
+
+/// What `figurine graph build` printed, and its wall seconds.
+struct Built {
+    wall: f64,
+    load: f64,
+    lma: f64,
+    posture: f64,
+    posture_cpu: f64,
+    style: f64,
+    cpu: f64,
+    peak: f64,
+    local_minima: f64,
+    edges: f64,
+}
+
+/// `figurine graph build LIB --out OUT`, timed from spawn to exit.
+fn build_cli(exe: &Path, lib: &Path, out: &Path) -> Result<Built> {
+    let t = Instant::now();
+    let text = run_out(
+        std::process::Command::new(exe)
+            .args(["graph", "build"])
+            .arg(lib)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet"),
+    )?;
+    let wall = t.elapsed().as_secs_f64();
+    Ok(Built {
+        wall,
+        load: number_after(&text, "load ")?,
+        lma: number_after(&text, ", LMA ")?,
+        posture: number_after(&text, "posture ")?,
+        posture_cpu: number_after(&text, "posture cpu ")?,
+        style: number_after(&text, "style ")?,
+        cpu: number_after(&text, ", cpu ")?,
+        peak: number_after(&text, "peak ")?,
+        local_minima: word_after(&text, "window pairs, ")?.parse()?,
+        edges: word_after(&text, "MG ")?.parse()?,
+    })
+}
+
+/// One engine run of library folder `lib` with bands of `band` frames: `srun figurine graph
+/// plan … --submit` (with `via_srun`; else the plan on this machine, outside Slurm, as a user
+/// on a login node would run it and `submit.sh`), then the graph file awaited; checks the
+/// merged bytes against `built`.
 fn engine_run(
     cluster: &Cluster,
-    clips: &[GraphClip],
+    lib: &Path,
     band: usize,
+    via_srun: bool,
     exe: &Path,
     dir: &Path,
     built: &[u8],
@@ -77,35 +147,33 @@ fn engine_run(
         .map(|n| n.get())
         .unwrap_or(1);
     let t0 = Instant::now();
-    let c0 = cpu_seconds().unwrap_or(f64::NAN);
-    let planned = plan_job(
-        clips,
-        &Default::default(),
-        &BuildParams::default(),
-        band,
-        &job,
-    )?;
-    write_scripts(&planned.manifest, &job, exe, &graph, cpus)?;
-    let (plan_s, plan_cpu) = (
-        t0.elapsed().as_secs_f64(),
-        cpu_seconds().unwrap_or(f64::NAN) - c0,
-    );
-    let ts = Instant::now();
-    let out = cluster
-        .command("sh")
-        .arg(job.join("submit.sh"))
-        .env("FIGURINE", exe)
-        .output()?;
-    let submit_s = ts.elapsed().as_secs_f64();
-    let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    let id = |key: &str| {
-        text.split(key)
-            .nth(1)
-            .and_then(|s| s.split_whitespace().next())
-            .map(str::to_string)
-            .with_context(|| format!("submit.sh: {text}{}", String::from_utf8_lossy(&out.stderr)))
+    let mut cmd = if via_srun {
+        let mut c = cluster.command("srun");
+        c.arg(format!("--cpus-per-task={cpus}"))
+            .arg("--job-name=figurine-plan")
+            .arg(exe);
+        c
+    } else {
+        cluster.command(&exe.to_string_lossy())
     };
-    let (array_id, merge_id) = (id("tiles: job ")?, id("merge: job ")?);
+    let text = run_out(
+        cmd.args(["graph", "plan"])
+            .arg(lib)
+            .arg("--out")
+            .arg(&job)
+            .args(["--band", &band.to_string(), "--submit", "--quiet"])
+            .env("FIGURINE", exe),
+    )?;
+    let srun_s = t0.elapsed().as_secs_f64();
+    let plan_id = if via_srun {
+        Some(word_after(&text, "when Slurm job ")?)
+    } else {
+        None
+    };
+    let (array_id, merge_id) = (
+        word_after(&text, "tiles: job ")?,
+        word_after(&text, "merge: job ")?,
+    );
     wait_for_graph(cluster, &merge_id, &graph, &job)?;
     let wall = t0.elapsed().as_secs_f64();
     let state = cluster
@@ -118,22 +186,26 @@ fn engine_run(
     if std::fs::read(&graph)? != built {
         bail!("the graph from the job array differs from graph build");
     }
-    let tiles = (0..planned.manifest.tiles.len())
+    let tiles_n: usize = word_after(&text, " frames, ")?.parse()?;
+    let tiles = (0..tiles_n)
         .map(|i| tile_log(&job, i))
         .collect::<Result<Vec<_>>>()?;
     let slurm = std::fs::read_to_string(cluster.controller_log())
         .ok()
-        .and_then(|log| timeline(&log, &array_id, &merge_id));
+        .and_then(|log| timeline(&log, plan_id.as_deref(), &array_id, &merge_id));
+    let store = std::fs::metadata(job.join("features.arrow"))?.len();
     Ok(EngineRun {
         tiles,
         merge_log,
-        plan_s,
-        features_s: planned.features_seconds,
-        write_s: planned.write_seconds,
-        plan_cpu,
-        submit_s,
+        srun_s,
+        plan_s: number_after(&text, "MiB; ")?,
+        load_s: number_after(&text, "(load ")?,
+        features_s: number_after(&text, ", features ")?,
+        write_s: number_after(&text, "store ")?,
+        plan_cpu: number_after(&text, "cpu ")?,
+        submit_s: number_after(&text, "submitted in ")?,
         wall,
-        store: planned.store_bytes,
+        store,
         slurm,
     })
 }
@@ -153,8 +225,13 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
             "no release figurine binary: cargo build --release -p figurine-host --bin figurine",
         )?;
     let dir = std::env::temp_dir().join(format!("figurine-graph-engine-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let p = BuildParams::default();
+    // The library as BVH files, so that `graph build` and `graph plan` read the same clips the
+    // way a user's commands would.
+    let lib = dir.join("library");
+    std::fs::create_dir_all(&lib)?;
+    for (k, c) in clips.iter().enumerate() {
+        write_bvh_path(&c.clip, &lib.join(format!("clip{k:03}.bvh")))?;
+    }
     let cluster = match Cluster::start(&dir.join("cluster")) {
         Ok(c) => Some(c),
         Err(why) => {
@@ -165,43 +242,55 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
     let mut fits: Vec<(f64, f64)> = Vec::new();
     let mut model: Option<(f64, f64, f64, f64, f64)> = None;
     let (mut merge_read, mut merge_style) = (f64::NAN, f64::NAN);
-    let mut rows: Vec<Vec<Row>> = vec![Vec::new(); bands.len()];
-    let mut tiles_of = vec![0usize; bands.len()];
-    let mut st = BuildStats::default();
-    let mut edges = 0;
+    // Each band twice: planned outside Slurm and submitted with submit.sh (the first task
+    // waits for the controller's next pass), then planned by an srun step that submits.
+    let jobs: Vec<(usize, bool)> = bands
+        .iter()
+        .flat_map(|&b| [(b, false), (b, true)])
+        .collect();
+    let label =
+        |&(band, srun): &(usize, bool)| format!("{band} {}", if srun { "srun" } else { "sbatch" });
+    let mut rows: Vec<Vec<Row>> = vec![Vec::new(); jobs.len()];
+    let mut tiles_of = vec![0usize; jobs.len()];
+    let (mut minima, mut edges) = (0.0, 0.0);
     let runs = runs.max(1);
     for rep in 0..runs {
-        let t = Instant::now();
-        let c0 = cpu_seconds().unwrap_or(f64::NAN);
-        let (g, stats) = build_graph(clips, &p)?;
         let built_path = dir.join("build.bin");
-        g.save(&built_path)?;
-        let build_s = t.elapsed().as_secs_f64();
-        let build_cpu = cpu_seconds().unwrap_or(f64::NAN) - c0;
+        let bl = build_cli(&exe, &lib, &built_path)?;
+        let (build_s, build_cpu) = (bl.wall, bl.cpu);
         let built = std::fs::read(&built_path)?;
-        edges = g.count(Variant::Mg, None, None);
+        (minima, edges) = (bl.local_minima, bl.edges);
         println!(
-            "{}graph build, {n} frames: {build_s:.2} s, cpu {build_cpu:.2} s (LMA {:.2} s, posture {:.2} s, style {:.2} s), peak {:.0} MiB; {} local maxima, {edges} MG edges",
+            "{}figurine graph build, {n} frames: {build_s:.2} s, cpu {build_cpu:.2} s (load {:.2} s, LMA {:.2} s, posture {:.2} s, style {:.2} s), peak {:.0} MiB; {minima} local maxima, {edges} MG edges",
             if runs > 1 { format!("run {}/{runs}: ", rep + 1) } else { String::new() },
-            stats.lma_seconds,
-            stats.posture_seconds,
-            stats.style_seconds,
-            peak_memory_mib().unwrap_or(f64::NAN),
-            stats.local_minima,
+            bl.load,
+            bl.lma,
+            bl.posture,
+            bl.style,
+            bl.peak,
         );
-        st = stats;
         let Some(cluster) = &cluster else {
             std::fs::remove_dir_all(&dir).ok();
             return Ok(());
         };
         println!(
-            "\n{:>6} {:>5} | {:>7} {:>6} {:>8} {:>6} {:>6} | {:>7} {:>6} | {:>6} {:>6} {:>6} {:>5} | {:>7} {:>6} {:>5}",
+            "\n{:>12} {:>5} | {:>7} {:>6} {:>8} {:>6} {:>6} | {:>7} {:>6} | {:>6} {:>6} {:>6} {:>5} | {:>7} {:>6} {:>5}",
             "band", "tiles", "build s", "plan s", "engine s", "wall+", "gap s", "cpu s", "cpu+", "tile s", "max s", "cpu s", "MiB", "merge s", "cpu s", "MiB"
         );
-        for (b, &band) in bands.iter().enumerate() {
-            let r = engine_run(cluster, clips, band, &exe, &dir, &built)?;
+        for (b, job) in jobs.iter().enumerate() {
+            let (band, via_srun) = *job;
+            let r = engine_run(cluster, &lib, band, via_srun, &exe, &dir, &built)?;
             let row = Row::of(&r, build_s, build_cpu);
-            row.print(&band.to_string(), r.tiles.len());
+            row.print(&label(job), r.tiles.len());
+            // The same kernel tiles in both: wall and CPU of the tiles' searches against the
+            // build's posture stage.
+            println!(
+                "        search: tiles {:.2} s, cpu {:.2} s; graph build's posture {:.2} s, cpu {:.2} s",
+                r.tiles.iter().map(|t| t.search_s).sum::<f64>(),
+                r.tiles.iter().map(|t| t.search_cpu).sum::<f64>(),
+                bl.posture,
+                bl.posture_cpu,
+            );
             tiles_of[b] = r.tiles.len();
             let k = r.tiles.len() as f64;
             let tiles_cpu: f64 = r.tiles.iter().map(|t| t.cpu_s).sum();
@@ -236,8 +325,8 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
     }
     if runs > 1 {
         println!("medians of {runs} runs:");
-        for (b, &band) in bands.iter().enumerate() {
-            Row::median(&rows[b]).print(&band.to_string(), tiles_of[b]);
+        for (b, job) in jobs.iter().enumerate() {
+            Row::median(&rows[b]).print(&label(job), tiles_of[b]);
         }
     }
     drop(cluster);
@@ -258,8 +347,8 @@ pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -
     let tile_s = MODEL_BAND * MODEL_BAND * s_pair + 2.0 * MODEL_BAND * s_read_frame;
     let scale = MODEL_FRAMES / n as f64;
     let pair_ratio = scale * scale;
-    let minima = st.local_minima as f64 * pair_ratio;
-    let edges_4m = edges as f64 * pair_ratio;
+    let minima = minima * pair_ratio;
+    let edges_4m = edges * pair_ratio;
     // Tile memory grows linearly with the band (its two bands' frames): fit to the two runs.
     let (slope, icpt) = match (fits.first(), fits.last()) {
         (Some(&(b1, m1)), Some(&(b2, m2))) if b2 != b1 => {

@@ -22,7 +22,7 @@ use super::lma::{clip_measurements, MEASUREMENTS};
 use super::search::{all_kernels, search, Found, FrameRows, Layout};
 use super::source::GraphClip;
 use super::style::{gauss_weights, pearson, similarity, Standardiser, SMOOTH_HALF};
-use super::{GraphError, HALF, WINDOW};
+use super::{cpu_seconds, GraphError, HALF, WINDOW};
 
 /// Timings and counts of a build, for reports and benchmarks.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -37,6 +37,9 @@ pub struct BuildStats {
     pub lma_seconds: f64,
     /// Seconds spent on the posture search.
     pub posture_seconds: f64,
+    /// CPU seconds of the posture search, all threads (NaN where /proc is missing): on a
+    /// shared machine this compares with a tile's search where wall time does not.
+    pub posture_cpu_seconds: f64,
     /// Seconds spent on style correlation of the candidates.
     pub style_seconds: f64,
 }
@@ -53,6 +56,7 @@ pub fn build_graph(
     stats.lma_seconds = t0.elapsed().as_secs_f64();
 
     let t1 = Instant::now();
+    let c1 = cpu_seconds().unwrap_or(f64::NAN);
     let rows = FrameRows::from_clips(clips);
     let n = rows.len();
     stats.frames = n;
@@ -64,6 +68,7 @@ pub fn build_graph(
     bar.finish_and_clear();
     drop(layout);
     stats.posture_seconds = t1.elapsed().as_secs_f64();
+    stats.posture_cpu_seconds = cpu_seconds().unwrap_or(f64::NAN) - c1;
     stats.local_minima = found.candidates.len();
     stats.pairs = found.pairs;
 

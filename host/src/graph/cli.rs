@@ -14,7 +14,7 @@ use super::inputs::{load, BuildOpts};
 use super::job_cli::{merge_cmd, plan_cmd, tile_cmd, MergeArgs, PlanArgs, TileArgs};
 use super::source::load_clip;
 use super::synth::{best_start, plan, reference_style, render, Chooser, Rng};
-use super::{GraphError, FPS};
+use super::{cpu_seconds, peak_memory_mib, GraphError, FPS};
 
 /// Style-coherent motion graphs (seed 003).
 #[derive(Args, Debug)]
@@ -111,6 +111,7 @@ pub fn run(args: GraphArgs) -> anyhow::Result<()> {
 fn build(a: BuildArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let (clips, roles, p) = load(&a.clips, &a.opts)?;
+    let load_seconds = t0.elapsed().as_secs_f64();
     let (mut g, st) = build_graph(&clips, &p)?;
     g.roles = roles;
     g.save(&a.out)?;
@@ -145,11 +146,15 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         scc(Variant::Lma)
     );
     println!(
-        "time: LMA {:.2} s, posture {:.2} s, style {:.2} s, total {:.2} s; wrote {}",
+        "time: load {:.2} s, LMA {:.2} s, posture {:.2} s (posture cpu {:.2} s), style {:.2} s, total {:.2} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+        load_seconds,
         st.lma_seconds,
         st.posture_seconds,
+        st.posture_cpu_seconds,
         st.style_seconds,
         t0.elapsed().as_secs_f64(),
+        cpu_seconds().unwrap_or(f64::NAN),
+        peak_memory_mib().unwrap_or(f64::NAN),
         a.out.display()
     );
     Ok(())

@@ -9,7 +9,7 @@ use super::graph::Variant;
 use super::inputs::{load, BuildOpts};
 use super::merge::merge_job;
 use super::plan::{plan_job, DEFAULT_BAND};
-use super::slurm::{write_scripts, DEFAULT_MAX_ARRAY_INDEX};
+use super::slurm::{own_job, submit, write_scripts, DEFAULT_MAX_ARRAY_INDEX};
 use super::tile::run_tile;
 use super::{cpu_seconds, peak_memory_mib, GraphError};
 
@@ -31,6 +31,10 @@ pub(super) struct PlanArgs {
     /// CPUs per Slurm task (default: this machine's).
     #[arg(long)]
     cpus_per_task: Option<usize>,
+    /// Submit the job (JOB/submit.sh) once planned. Inside a Slurm job (`srun figurine graph
+    /// plan … --submit`) the tiles wait for that job and start as soon as it ends.
+    #[arg(long)]
+    submit: bool,
     #[command(flatten)]
     opts: BuildOpts,
 }
@@ -65,6 +69,7 @@ pub(super) struct MergeArgs {
 pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let (clips, roles, p) = load(&a.clips, &a.opts)?;
+    let load_seconds = t0.elapsed().as_secs_f64();
     let planned = plan_job(&clips, &roles, &p, a.band, &a.out)?;
     let m = &planned.manifest;
     let graph = a.graph.unwrap_or_else(|| a.out.join("graph.bin"));
@@ -81,15 +86,39 @@ pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
         );
     }
     println!(
-        "plan {}: {} clips, {} frames, {} tiles ({} frames per band); features {:.1} MiB; {:.2} s",
+        "plan {}: {} clips, {} frames, {} tiles ({} frames per band); features {:.1} MiB; {:.2} s (load {:.3} s, features {:.3} s, store {:.3} s), cpu {:.2} s",
         m.plan,
         m.clips.len(),
         m.frames,
         m.tiles.len(),
         m.band,
         planned.store_bytes as f64 / (1024.0 * 1024.0),
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        load_seconds,
+        planned.features_seconds,
+        planned.write_seconds,
+        cpu_seconds().unwrap_or(f64::NAN),
     );
+    if m.tiles.len() > DEFAULT_MAX_ARRAY_INDEX + 1 {
+        eprintln!(
+            "note: {} tiles exceed Slurm's default MaxArraySize (1001): raise it, or plan with a larger --band",
+            m.tiles.len()
+        );
+    }
+    if a.submit {
+        let after = own_job();
+        let t1 = Instant::now();
+        let s = submit(&a.out, after.as_deref())?;
+        println!(
+            "{} (submitted in {:.3} s)",
+            s.message,
+            t1.elapsed().as_secs_f64()
+        );
+        if let Some(id) = after {
+            println!("the tiles start when Slurm job {id} (this plan) ends");
+        }
+        return Ok(());
+    }
     let job = a.out.display();
     println!("run with Slurm:   sh {job}/submit.sh        (tiles as a job array, then the merge)");
     println!(
@@ -98,12 +127,6 @@ pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
         m.tiles.len() - 1,
         graph.display()
     );
-    if m.tiles.len() > DEFAULT_MAX_ARRAY_INDEX + 1 {
-        eprintln!(
-            "note: {} tiles exceed Slurm's default MaxArraySize (1001): raise it, or plan with a larger --band",
-            m.tiles.len()
-        );
-    }
     Ok(())
 }
 
@@ -111,13 +134,14 @@ pub(super) fn plan_cmd(a: PlanArgs) -> anyhow::Result<()> {
 pub(super) fn tile_cmd(a: TileArgs) -> anyhow::Result<()> {
     let r = run_tile(&a.job, a.index, !a.quiet)?;
     println!(
-        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.3} s, search {:.3} s, write {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+        "tile {}: {} kernel tiles, {} window pairs, {} local minima; read {:.3} s, search {:.3} s (search cpu {:.2} s), write {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
         a.index,
         r.kernels,
         r.found.pairs,
         r.found.candidates.len(),
         r.read_seconds,
         r.search_seconds,
+        r.search_cpu_seconds,
         r.write_seconds,
         cpu_seconds().unwrap_or(f64::NAN),
         peak_memory_mib().unwrap_or(f64::NAN),

@@ -16,7 +16,8 @@
 //! whole clip: a tile that holds only its bands could not reproduce them bit for bit.
 //!
 //! Rows come in record batches of [`BATCH_ROWS`] (the last one shorter), so a tile reads only
-//! the batches its bands touch, and only the columns it needs. Size: 4 + 192 + 12 + 456 bytes
+//! the batches its bands touch, and only the bytes of the columns it needs
+//! ([`super::ipc_prefix`]). Size: 4 + 192 + 12 + 456 bytes
 //! of values per frame plus validity bits and padding, about 664 MB (633 MiB) per million
 //! frames, uncompressed (compression would add codecs to the build for data that compresses
 //! poorly: f32 motion).
@@ -39,6 +40,7 @@ use arrow_ipc::writer::FileWriter;
 use arrow_schema::{DataType, Field, Schema};
 use glam::Vec3;
 
+use super::ipc_prefix::LeadingColumns;
 use super::lma::MEASUREMENTS;
 use super::posture::WindowTerms;
 use super::roles::Role;
@@ -47,6 +49,11 @@ use super::GraphError;
 
 /// Version of the feature store layout this build writes and reads.
 pub const STORE_VERSION: u32 = 1;
+/// IPC buffers of a record batch's first five columns (what a tile reads): `clip` 2, `points`
+/// 3 (list validity, item validity and values), the three window terms 2 each.
+const SEARCH_BUFFERS: usize = 11;
+/// IPC buffers of a whole record batch: those and the `lma` column's 3.
+const ALL_BUFFERS: usize = 14;
 /// Rows per record batch (the last batch of a file may be shorter).
 pub const BATCH_ROWS: usize = 65_536;
 /// Floats per frame in the `points` column (16 role points × x y z).
@@ -262,6 +269,12 @@ impl Store {
             .next()
             .ok_or_else(|| arrow_err(&self.path, format!("record batch {k} missing")))?
             .map_err(|e| arrow_err(&self.path, format!("record batch {k}: {e}")))?;
+        self.check_rows(&b, k)?;
+        Ok(b)
+    }
+
+    /// Checks that record batch `b`, number `k`, has the expected row count.
+    fn check_rows(&self, b: &RecordBatch, k: usize) -> Result<(), GraphError> {
         let want = (self.frames - k * BATCH_ROWS).min(BATCH_ROWS);
         if b.num_rows() != want {
             return Err(arrow_err(
@@ -272,7 +285,7 @@ impl Store {
                 ),
             ));
         }
-        Ok(b)
+        Ok(())
     }
 
     /// The search inputs of global frames `range` (clip, points, window terms).
@@ -290,9 +303,12 @@ impl Store {
                 format!("frames {range:?} past the end"),
             ));
         }
-        let mut r = self.reader(Some(vec![0, 1, 2, 3, 4]))?;
+        // Only the bytes of the first five columns are read: the LMA column, last in every
+        // batch, is two-thirds of the file and only the merge needs it.
+        let mut r = LeadingColumns::open(&self.path, 5, SEARCH_BUFFERS, ALL_BUFFERS)?;
         for k in range.start / BATCH_ROWS..=(range.end - 1) / BATCH_ROWS {
-            let b = self.batch(&mut r, k)?;
+            let b = r.batch(k)?;
+            self.check_rows(&b, k)?;
             let lo = range.start.max(k * BATCH_ROWS) - k * BATCH_ROWS;
             let hi = range.end.min((k + 1) * BATCH_ROWS) - k * BATCH_ROWS;
             let bad = |what: &str| {

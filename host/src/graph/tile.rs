@@ -35,7 +35,7 @@ use super::plan::{
 };
 use super::search::{band_frames, search, Candidate, Found, Layout};
 use super::store::Store;
-use super::GraphError;
+use super::{cpu_seconds, GraphError};
 
 /// Magic bytes at the start of a tile file.
 pub const MAGIC: &[u8; 8] = b"FIGTILE\0";
@@ -270,6 +270,8 @@ pub struct TileRun {
     pub read_seconds: f64,
     /// Seconds of the search.
     pub search_seconds: f64,
+    /// CPU seconds of the search, all threads (NaN where /proc is missing).
+    pub search_cpu_seconds: f64,
     /// Seconds writing the tile file.
     pub write_seconds: f64,
 }
@@ -297,6 +299,7 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
     };
     let read_seconds = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
+    let c1 = cpu_seconds().unwrap_or(f64::NAN);
     let kernels = m.kernels(&spec);
     let bar = progress_bar(progress, kernels.len() as u64, "posture correlation");
     let found = search(
@@ -309,6 +312,7 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
     );
     bar.finish_and_clear();
     let search_seconds = t1.elapsed().as_secs_f64();
+    let search_cpu_seconds = cpu_seconds().unwrap_or(f64::NAN) - c1;
     let file = TileFile {
         version: JOB_VERSION,
         index: index as u32,
@@ -324,6 +328,7 @@ pub fn run_tile(job: &Path, index: usize, progress: bool) -> Result<TileRun, Gra
         kernels: kernels.len(),
         read_seconds,
         search_seconds,
+        search_cpu_seconds,
         write_seconds: t2.elapsed().as_secs_f64(),
     })
 }

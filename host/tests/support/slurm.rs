@@ -19,6 +19,12 @@
 //!   job it waited for (0.9–1.1 s measured with Slurm 22.05). With an epilog, slurmd reports
 //!   the epilog's end (`MESSAGE_EPILOG_COMPLETE`), the one event on which slurmctld schedules
 //!   immediately, and the next job starts within about 0.1 s.
+//!
+//! No setting makes slurmctld start a *batch* job on its submission (Slurm 22.05's
+//! `job_allocate` only tests batch jobs; `defer`, `sched_min_interval` and `sched_interval` act
+//! on later passes): the first array task waits 0–1 s for the next pass unless a job it
+//! depends on ends, which is why `graph plan --submit` run under `srun` (allocated at once)
+//! makes the tiles wait for the plan's own job.
 
 #![allow(dead_code)]
 
@@ -28,11 +34,12 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// Programs the cluster needs and the Debian package of each.
-const PROGRAMS: [(&str, &str); 6] = [
+const PROGRAMS: [(&str, &str); 7] = [
     ("munged", "munge"),
     ("slurmctld", "slurmctld"),
     ("slurmd", "slurmd"),
     ("sbatch", "slurm-client"),
+    ("srun", "slurm-client"),
     ("sinfo", "slurm-client"),
     ("scontrol", "slurm-client"),
 ];
