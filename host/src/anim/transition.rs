@@ -208,7 +208,7 @@ pub fn calm_root(frames: &mut [Pose], join: usize, reach: usize, most: f32) -> u
     let mut passes = 0;
     while passes < CALM_PASSES && judged.clone().any(|f| accel(frames, f) > most) {
         let before: Vec<Vec3> = (lo - 1..=hi + 1).map(|f| root(frames, f)).collect();
-        for f in lo..=hi {
+        for (f, pose) in frames.iter_mut().enumerate().take(hi + 1).skip(lo) {
             let d = f.abs_diff(join);
             let weight = if d <= full {
                 1.0
@@ -217,7 +217,7 @@ pub fn calm_root(frames: &mut [Pose], join: usize, reach: usize, most: f32) -> u
             };
             let k = f - (lo - 1);
             let mean = (before[k - 1] + 2.0 * before[k] + before[k + 1]) * 0.25;
-            if let Some(t) = frames[f].translations.first_mut() {
+            if let Some(t) = pose.translations.first_mut() {
                 *t += (mean - before[k]) * weight;
             }
         }
