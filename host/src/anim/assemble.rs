@@ -48,11 +48,12 @@ use super::library::ActionClip;
 use super::looping::{close_loop, cycle_frames, loop_closure};
 use super::mirror::plays_mirrored;
 use super::pacing::{
-    ground_travel, pace, root_speed_max, shrink, HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM,
+    ground_travel, pace, root_speed_max, shrink, PaceLimits, HUMAN_ROOT_ACCEL_M_S2,
+    HUMAN_ROOT_SPEED_M_S, PACE_HEADROOM,
 };
 use super::phrasing::{detect_stages, Phrasing, Stage};
 use super::trajectory::{ground, yaw_between, GroundPath, Polyline, DEFAULT_WORLD_SCALE};
-use super::transition::{best_pair, blend_world, ease_root, smoothstep, ROOT_EASE_S};
+use super::transition::{best_pair, blend_world, calm_root, ease_root, smoothstep, ROOT_EASE_S};
 use super::variants::{choose_variant, VariantChoice};
 use super::AnimError;
 use crate::events::ActionRecord;
@@ -83,6 +84,12 @@ pub const MAX_PATH_SHRINKS: usize = 4;
 /// limit itself, since the ground pass after it raises the root by a millimetre here and there
 /// (a strong jump eased to the limit landed at 4.2004 m/s).
 pub const JOIN_EASE_HEADROOM: f32 = 0.99;
+
+/// Share of the real takes' bound on a join's root acceleration
+/// ([`super::envelope::ROOT_ACCEL_JOIN_M_S2`]) [`assemble`] smooths a join's root to: the
+/// passes after it (re-planting the feet, the ground pass) move the root by a millimetre
+/// here and there.
+pub const CALM_HEADROOM: f32 = 0.8;
 
 /// Knobs of the assembler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -212,6 +219,8 @@ struct Placed {
     source_start_s: Option<f32>,
     /// Per frame, per leg: the source clip's foot contact at the frame's source time.
     contacts: Vec<Vec<bool>>,
+    /// Output frame time, s.
+    frame_s: f32,
 }
 
 impl Placed {
@@ -416,7 +425,11 @@ pub fn assemble_guided(
         let top_speed = HUMAN_ROOT_SPEED_M_S * PACE_HEADROOM;
         let (ec, cycle_s) = ec.paced(
             (f1 - f0) as f32 / fps / cycles.max(1) as f32,
-            top_speed / stretch,
+            &PaceLimits {
+                speed_m_s: top_speed / stretch,
+                accel_m_s2: HUMAN_ROOT_ACCEL_M_S2,
+                frame_s: 1.0 / fps,
+            },
         );
         f1 = f1.max(f0 + (cycle_s * cycles.max(1) as f32 * fps).ceil() as usize);
         // Nor faster than a person moves: an action whose root would outrun
@@ -504,6 +517,7 @@ pub fn assemble_guided(
             effort,
             file: ac.file.clone(),
             source_start_s: ac.source_start_s,
+            frame_s: 1.0 / fps,
         });
         last_f1 = f1;
     }
@@ -567,7 +581,13 @@ pub fn assemble_guided(
                 }
             })
             .collect();
-        let (i, j) = match best_pair(&pa, ra.clone(), &pb, rb.clone()) {
+        // A blend starts and ends where the root moves no more sharply than real takes
+        // mostly do (a turn's hop, a strong jump's squat would show at the blend's edge), if
+        // the search finds such frames.
+        let (ca, cb) = (calm_frames(a, ra.clone()), calm_frames(b, rb.clone()));
+        let ra: Vec<usize> = if ca.is_empty() { ra.collect() } else { ca };
+        let rb: Vec<usize> = if cb.is_empty() { rb.collect() } else { cb };
+        let (i, j) = match best_pair(&pa, ra, &pb, rb) {
             Some((i, j, _)) => (i, j),
             None => (a.f1(), b.f0),
         };
@@ -636,6 +656,12 @@ pub fn assemble_guided(
             }
         }
     }
+    // Nor is the root's path sharper about a join than real takes move theirs: where the
+    // action is cut mid-hop, it settles there.
+    let most = super::envelope::ROOT_ACCEL_JOIN_M_S2 * CALM_HEADROOM / (fps * fps);
+    for &k in &joins {
+        calm_root(&mut frames, k, JOIN_EASE_REACH, most);
+    }
     let mut clip = Clip {
         name: "figurine".into(),
         skeleton,
@@ -684,6 +710,23 @@ pub fn residual_effort(recognised: Effort, variant: Option<&VariantChoice>) -> E
         .sanitized(),
         None => e,
     }
+}
+
+/// The frames of `range` at which `p`'s placed root accelerates within
+/// [`super::envelope::ROOT_ACCEL_JOIN_M_S2`] for [`JOIN_EASE_REACH`] frames either side (as
+/// `figurine check` judges a join).
+fn calm_frames(p: &Placed, range: std::ops::RangeInclusive<usize>) -> Vec<usize> {
+    let dt = p.frame_s;
+    let accel = |f: usize| {
+        let r = |k: usize| p.at(k).translations[0];
+        (r(f + 1) - 2.0 * r(f) + r(f.saturating_sub(1))).length() / (dt * dt)
+    };
+    range
+        .filter(|&f| {
+            (f.saturating_sub(JOIN_EASE_REACH)..=f + JOIN_EASE_REACH)
+                .all(|k| accel(k) <= super::envelope::ROOT_ACCEL_JOIN_M_S2)
+        })
+        .collect()
 }
 
 /// Stretches a cut (i, j) to at least `min_blend` frames, half before and half after, staying

@@ -90,6 +90,10 @@ pub struct EffortClip {
     pub phrasing: Phrasing,
     /// Monotone table of (w, source seconds), w from 0 to 1.
     pub(super) table: Vec<(f32, f32)>,
+    /// Seconds the table's timing lasts at the effort's own pace (eq. 6's stage clock: the
+    /// source's length for a neutral Time, shorter for sudden, longer for sustained), before
+    /// an event's length stretches or squeezes it.
+    pub(super) natural_s: f32,
 }
 
 impl EffortClip {
@@ -265,6 +269,7 @@ pub fn apply_effort(
         clip: out,
         phrasing: phrasing.clone(),
         table,
+        natural_s: end,
     }
 }
 
@@ -375,8 +380,20 @@ fn rescale_stages(
                     (quat_pow(qs * qt.inverse(), c).inverse() * ref_out.rotations[j]).normalize()
                 };
                 let mut q = at(c);
-                if let Some(r) = ranges.filter(|r| !r.contains(j, q) && r.contains(j, at(1.0))) {
-                    let (mut inside, mut outside) = (1.0, c);
+                // The factor nearest c that keeps the joint within its range, from the
+                // source's own motion (1) if that is within, else from the stage's rescaled
+                // reference (0): where an earlier stage's factor moved the reference, even the
+                // source's own motion from it may leave the range (a crouch's rise amplified
+                // from a squat that sudden anticipation made shallower swings the leg back
+                // past standing, up behind the body).
+                let within = ranges.filter(|r| !r.contains(j, q)).and_then(|r| {
+                    [1.0, 0.0]
+                        .into_iter()
+                        .find(|&k| r.contains(j, at(k)))
+                        .map(|k| (r, k))
+                });
+                if let Some((r, from)) = within {
+                    let (mut inside, mut outside) = (from, c);
                     for _ in 0..RANGE_BISECTIONS {
                         let mid = 0.5 * (inside + outside);
                         if r.contains(j, at(mid)) {
@@ -655,5 +672,69 @@ mod tests {
         assert!(spine_tilt(&strong.clip, mid) > spine_tilt(&light.clip, mid));
         let amp = |k: &Clip| joint_speeds(k).iter().sum::<f32>();
         assert!(amp(&strong.clip) > amp(&c) && amp(&c) > amp(&light.clip));
+    }
+
+    #[test]
+    fn a_return_amplified_from_a_moved_reference_stays_within_the_joints_range() {
+        use crate::anim::phrasing::StageSpan;
+        use crate::motion::Joint;
+        // A joint bends 1.5 rad (anticipation) and straightens again (execution).
+        let skeleton = Skeleton {
+            joints: vec![
+                Joint::bare("root", None, Vec3::ZERO),
+                Joint::bare("knee", Some(0), Vec3::new(0.0, -0.4, 0.0)),
+            ],
+        };
+        let frames: Vec<Pose> = (0..=40)
+            .map(|f| {
+                let mut p = Pose::rest(&skeleton);
+                let bend = 1.5 * (1.0 - (f as f32 - 20.0).abs() / 20.0);
+                p.rotations[1] = Quat::from_rotation_x(bend);
+                p.translations[0] = Vec3::new(0.0, 0.9, 0.0);
+                p
+            })
+            .collect();
+        let clip = Clip {
+            name: "bend".into(),
+            skeleton,
+            frame_time: 1.0 / 30.0,
+            frames,
+        };
+        let phrasing = Phrasing {
+            spans: vec![
+                StageSpan {
+                    stage: Stage::Anticipation,
+                    start: 0,
+                    end: 20,
+                },
+                StageSpan {
+                    stage: Stage::Execution,
+                    start: 20,
+                    end: 40,
+                },
+            ],
+            speed: vec![1.0; 41],
+        };
+        let ranges = JointRanges::learn([&clip]);
+        // Sudden and strong: the bend is rescaled by ½ (so it ends shallower), its return by
+        // 2 from there: −3 rad from a 0.75 rad bend, past straight and round behind.
+        let ec = apply_effort(
+            &clip,
+            &phrasing,
+            Effort {
+                time: 1.0,
+                weight: 1.0,
+            },
+            Vec3::Z,
+            false,
+            Some(&ranges),
+        );
+        for (f, p) in ec.clip.frames.iter().enumerate() {
+            assert!(
+                ranges.contains(1, p.rotations[1]),
+                "frame {f}: {:?}",
+                p.rotations[1]
+            );
+        }
     }
 }

@@ -10,7 +10,9 @@
 //!   (and the assembler shrinks it further where the cycle's bob and surge on top of that
 //!   pace would outrun [`HUMAN_ROOT_SPEED_M_S`]);
 //! - **any clip** ([`EffortClip::paced`]): no stretch of its time map moves the root faster
-//!   than a person ([`HUMAN_ROOT_SPEED_M_S`]); such stretches borrow time from the slow ones.
+//!   than a person ([`HUMAN_ROOT_SPEED_M_S`]), nor squeezes it, beyond the effort's own
+//!   timing, into accelerating harder than a person ([`HUMAN_ROOT_ACCEL_M_S2`]); such
+//!   stretches borrow time from the slow ones.
 
 use glam::Vec3;
 
@@ -29,6 +31,27 @@ pub const MAX_CADENCE: f32 = 1.5;
 /// ([`super::envelope::ROOT_SPEED_M_S`]). No person's hips outrun it; an action that
 /// would is given more time.
 pub const HUMAN_ROOT_SPEED_M_S: f32 = super::envelope::ROOT_SPEED_M_S;
+
+/// The hardest a character's root may be made to accelerate by squeezing a clip into a short
+/// event, m/s²: the largest root acceleration among the real takes within the rest of the
+/// envelope (DeepMimic's spinning kick, 48 m/s²; its kick 40, its jump 35; people walking
+/// 6–13). Acceleration goes as the square of the squeeze: the sudden, strong jump's backflip
+/// squeezed 2.6× into a 0.7 s event took off at 181 m/s². Effort's own retiming (a sudden
+/// execution, eq. 6) is the performer's and is left as it is; only what the event's length
+/// adds is held here.
+pub const HUMAN_ROOT_ACCEL_M_S2: f32 = 48.0;
+
+/// The limits [`EffortClip::paced`] holds a clip's root within.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaceLimits {
+    /// Fastest root speed, m/s.
+    pub speed_m_s: f32,
+    /// Hardest root acceleration a squeeze beyond the effort's own timing may bring, m/s².
+    pub accel_m_s2: f32,
+    /// Output frame time, s: the step at which the root's acceleration is judged (as
+    /// `figurine check` judges it, frame to frame).
+    pub frame_s: f32,
+}
 
 /// Share of [`HUMAN_ROOT_SPEED_M_S`] an action is paced to: the passes after placement (the
 /// ground pass raising a root whose leg cannot reach, blends between actions) move the root
@@ -110,23 +133,48 @@ pub(super) fn root_speed_max(poses: &[Pose], dt: f32) -> f32 {
 }
 
 impl EffortClip {
-    /// This clip played over `seconds` with its root never faster than `top_speed` (m/s):
+    /// This clip played over `seconds` with its root never faster than `limits.speed_m_s`:
     /// where the time map would move the root faster (a sudden retime compressing a lunge or a
     /// take-off, a long clip squeezed into a short event), that stretch is given the time the
     /// speed needs and the rest of the clip gives it back, its own timing scaled evenly; only
-    /// when even that cannot make room does the clip take longer. Returns the clip and the
-    /// seconds it now lasts (≥ `seconds`). The effort's shape stays: slow parts stay slow,
-    /// fast parts as fast as a person moves.
-    pub fn paced(&self, seconds: f32, top_speed: f32) -> (EffortClip, f32) {
+    /// when even that cannot make room does the clip take longer. Likewise no stretch is
+    /// squeezed beyond the effort's own timing (`natural_s`) so far that its
+    /// root accelerates harder than `limits.accel_m_s2` (acceleration grows with the square
+    /// of the squeeze): a backflip squeezed into a short event takes the time its take-off
+    /// needs. Returns the clip and the seconds it now lasts (≥ `seconds`). The effort's
+    /// shape stays: slow parts stay slow, fast parts as fast as a person moves.
+    pub fn paced(&self, seconds: f32, limits: &PaceLimits) -> (EffortClip, f32) {
         let n = self.table.len();
-        if n < 2 || !(seconds > 0.0 && top_speed > 0.0) {
+        let PaceLimits {
+            speed_m_s,
+            accel_m_s2,
+            frame_s,
+        } = *limits;
+        if n < 2 || !(seconds > 0.0 && speed_m_s > 0.0 && accel_m_s2 > 0.0 && frame_s > 0.0) {
             return (self.clone(), seconds.max(0.0));
         }
         let root = |s: f32| self.clip.sample(s).translations[0];
         let positions: Vec<Vec3> = self.table.iter().map(|e| root(e.1)).collect();
+        let end_s = self.clip.duration();
+        // The root's acceleration on the clip's own clock at source second `s`, judged one
+        // output frame either side (finer steps would read the take's jitter as acceleration
+        // a squeezed playback never shows).
+        let accel_at = |s: f32| {
+            let (a, b) = ((s - frame_s).max(0.0), (s + frame_s).min(end_s));
+            let (da, db) = ((s - a).max(1e-6), (b - s).max(1e-6));
+            let (x0, x1, x2) = (root(a), root(s), root(b));
+            ((x2 - x1) / db - (x1 - x0) / da).length() / (0.5 * (da + db))
+        };
         let need: Vec<f32> = positions
             .windows(2)
-            .map(|w| (w[1] - w[0]).length() / top_speed)
+            .zip(self.table.windows(2))
+            .map(|(p, e)| {
+                let span = (e[1].1 - e[0].1).max(0.0);
+                let natural = (e[1].0 - e[0].0) * self.natural_s;
+                // Played `r` times as fast, a stretch accelerates r² times as hard.
+                let squeezed = span * (accel_at(0.5 * (e[0].1 + e[1].1)) / accel_m_s2).sqrt();
+                ((p[1] - p[0]).length() / speed_m_s).max(squeezed.min(natural))
+            })
             .collect();
         let have: Vec<f32> = self
             .table
@@ -165,6 +213,7 @@ impl EffortClip {
                 clip: self.clip.clone(),
                 phrasing: self.phrasing.clone(),
                 table,
+                natural_s: out_seconds,
             },
             out_seconds,
         )
@@ -204,6 +253,15 @@ mod tests {
         }
     }
 
+    /// Limits on the root's speed alone (`top` m/s), judged at 30 fps.
+    fn speed(top: f32) -> PaceLimits {
+        PaceLimits {
+            speed_m_s: top,
+            accel_m_s2: f32::INFINITY,
+            frame_s: 1.0 / 30.0,
+        }
+    }
+
     fn fastest(ec: &EffortClip, seconds: f32) -> f32 {
         let n = (seconds * 30.0).round() as usize;
         let poses: Vec<Pose> = (0..=n).map(|k| ec.pose(k as f32 / n as f32)).collect();
@@ -223,7 +281,7 @@ mod tests {
         );
         // Played over 1.05 s (2× fast) the lunge moves at 12 m/s.
         assert!(fastest(&ec, 1.05) > 10.0, "{}", fastest(&ec, 1.05));
-        let (paced, seconds) = ec.paced(1.05, 4.0);
+        let (paced, seconds) = ec.paced(1.05, &speed(4.0));
         assert_eq!(seconds, 1.05, "the still parts had time to give");
         assert!(
             fastest(&paced, seconds) <= 4.0 * 1.02,
@@ -231,12 +289,89 @@ mod tests {
             fastest(&paced, seconds)
         );
         // Squeezed into 0.1 s it cannot be paced within the time: it takes longer.
-        let (_, longer) = ec.paced(0.1, 4.0);
+        let (_, longer) = ec.paced(0.1, &speed(4.0));
         assert!(longer >= 0.6 / 4.0 - 1e-3, "{longer}");
         // Slow enough already: unchanged.
-        let (same, s) = ec.paced(2.1, 10.0);
+        let (same, s) = ec.paced(2.1, &speed(10.0));
         assert_eq!(s, 2.1);
         assert_eq!(same.source_time(0.5), ec.source_time(0.5));
+    }
+
+    /// A one-joint clip whose root drops 0.3 m and rises back over 1 s (30 fps): a squat,
+    /// up to 0.15 · (2π)² ≈ 5.9 m/s² at its own pace.
+    fn squat() -> Clip {
+        let skeleton = Skeleton {
+            joints: vec![Joint::bare("root", None, Vec3::ZERO)],
+        };
+        let frames = (0..=30)
+            .map(|f| {
+                let mut p = Pose::rest(&skeleton);
+                let u = f as f32 / 30.0;
+                p.translations[0] = Vec3::new(
+                    0.0,
+                    0.9 - 0.15 * (1.0 - (std::f32::consts::TAU * u).cos()),
+                    0.0,
+                );
+                p
+            })
+            .collect();
+        Clip {
+            name: "squat".into(),
+            skeleton,
+            frame_time: 1.0 / 30.0,
+            frames,
+        }
+    }
+
+    /// The hardest root acceleration of `ec` played over `seconds` at 30 fps, m/s².
+    fn hardest(ec: &EffortClip, seconds: f32) -> f32 {
+        let n = (seconds * 30.0).round() as usize;
+        let h = seconds / n as f32;
+        let y: Vec<Vec3> = (0..=n)
+            .map(|k| ec.pose(k as f32 / n as f32).translations[0])
+            .collect();
+        y.windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).length() / (h * h))
+            .fold(0.0, f32::max)
+    }
+
+    #[test]
+    fn a_squat_squeezed_into_a_short_event_takes_the_time_its_acceleration_needs() {
+        let clip = squat();
+        let ec = apply_effort(
+            &clip,
+            &Phrasing::whole(&clip),
+            Effort::default(),
+            Vec3::X,
+            false,
+            None,
+        );
+        // Squeezed 8× it would accelerate at 64 × 5.9 ≈ 380 m/s².
+        assert!(hardest(&ec, 0.125) > 300.0, "{}", hardest(&ec, 0.125));
+        let limits = PaceLimits {
+            speed_m_s: 4.0,
+            accel_m_s2: 20.0,
+            frame_s: 1.0 / 30.0,
+        };
+        let (paced, seconds) = ec.paced(0.125, &limits);
+        // ∫ √(|a| / 20) dt over the squat ≈ 0.41 s at the least.
+        assert!(seconds > 0.35 && seconds < 0.5, "{seconds}");
+        // Each stretch is held to the bound at its own pace; the change of pace from one
+        // stretch to the next adds to it (here 47 m/s², 2.4× the bound: the pace is not yet
+        // smoothed), still 8× less than the even squeeze's 380 m/s².
+        eprintln!(
+            "paced squat: {seconds:.3} s, hardest {:.1} m/s²",
+            hardest(&paced, seconds)
+        );
+        assert!(
+            hardest(&paced, seconds) <= 20.0 * 3.0,
+            "{}",
+            hardest(&paced, seconds)
+        );
+        // At its own pace or slower it is left alone.
+        let (same, s) = ec.paced(1.5, &limits);
+        assert_eq!(s, 1.5);
+        assert_eq!(same.source_time(0.3), ec.source_time(0.3));
     }
 
     #[test]

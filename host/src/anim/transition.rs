@@ -67,21 +67,25 @@ pub fn window_distance(a: &[Vec<Vec3>], i: usize, b: &[Vec<Vec3>], j: usize, hal
     aligned_distance(&ca, &cb).0
 }
 
-/// The pair (i in `range_a`, j in `range_b`) with the least windowed posture distance.
-pub fn best_pair(
+/// The pair (i among `range_a`, j among `range_b`) with the least windowed posture distance.
+pub fn best_pair<A, B>(
     a: &[Vec<Vec3>],
-    range_a: std::ops::RangeInclusive<usize>,
+    range_a: A,
     b: &[Vec<Vec3>],
-    range_b: std::ops::RangeInclusive<usize>,
-) -> Option<(usize, usize, f32)> {
+    range_b: B,
+) -> Option<(usize, usize, f32)>
+where
+    A: IntoIterator<Item = usize>,
+    B: IntoIterator<Item = usize> + Clone,
+{
     let mut best: Option<(usize, usize, f32)> = None;
-    for i in range_a.clone() {
+    for i in range_a {
         if i >= a.len() {
-            break;
+            continue;
         }
         for j in range_b.clone() {
             if j >= b.len() {
-                break;
+                continue;
             }
             let d = window_distance(a, i, b, j, WINDOW_HALF);
             if best.is_none_or(|(_, _, bd)| d < bd) {
@@ -168,6 +172,58 @@ pub fn ease_root(frames: &mut [Pose], join: usize, half: usize, top: f32) {
             *t += shift;
         }
     }
+}
+
+/// Frames over which [`calm_root`]'s smoothing fades out beyond the frames it judges.
+pub const CALM_FADE: usize = 3;
+/// Most smoothing passes [`calm_root`] makes about one join.
+pub const CALM_PASSES: usize = 60;
+
+/// Smooths the root's path about frame `join` of `frames` until its acceleration (second
+/// difference, distance per frame²) within `reach` frames of the join is at most `most`:
+/// each pass moves every root there towards the mean of its neighbours ([1, 2, 1] / 4), fully
+/// within `reach + 1` frames of the join and fading out over [`CALM_FADE`] frames beyond. An
+/// action cut mid-hop (a sudden turn's bob, a strong jump's squat) no longer shows its sharpest
+/// motion at the cut; it settles into the next one as a person's hips do, the rest of it as it
+/// was. Returns the passes made.
+pub fn calm_root(frames: &mut [Pose], join: usize, reach: usize, most: f32) -> usize {
+    let n = frames.len();
+    let root = |frames: &[Pose], f: usize| {
+        frames[f]
+            .translations
+            .first()
+            .copied()
+            .unwrap_or(Vec3::ZERO)
+    };
+    let accel = |frames: &[Pose], f: usize| {
+        (root(frames, f + 1) - 2.0 * root(frames, f) + root(frames, f - 1)).length()
+    };
+    let judged = join.saturating_sub(reach).max(1)..=(join + reach).min(n.saturating_sub(2));
+    let full = reach + 1;
+    let lo = join.saturating_sub(full + CALM_FADE).max(1);
+    let hi = (join + full + CALM_FADE).min(n.saturating_sub(2));
+    if judged.is_empty() || lo > hi {
+        return 0;
+    }
+    let mut passes = 0;
+    while passes < CALM_PASSES && judged.clone().any(|f| accel(frames, f) > most) {
+        let before: Vec<Vec3> = (lo - 1..=hi + 1).map(|f| root(frames, f)).collect();
+        for (f, pose) in frames.iter_mut().enumerate().take(hi + 1).skip(lo) {
+            let d = f.abs_diff(join);
+            let weight = if d <= full {
+                1.0
+            } else {
+                1.0 - (d - full) as f32 / (CALM_FADE + 1) as f32
+            };
+            let k = f - (lo - 1);
+            let mean = (before[k - 1] + 2.0 * before[k] + before[k + 1]) * 0.25;
+            if let Some(t) = pose.translations.first_mut() {
+                *t += (mean - before[k]) * weight;
+            }
+        }
+        passes += 1;
+    }
+    passes
 }
 
 /// Bisection steps of [`ease_root`]'s share of a step that keeps the root within its speed.
@@ -329,5 +385,41 @@ mod tests {
         let (i, j, d) = best_pair(&a, 20..=30, &b, 10..=20).unwrap();
         assert_eq!(i, j + 7, "{i} {j} {d}");
         assert!(d < 1e-4);
+    }
+
+    #[test]
+    fn a_root_cut_mid_hop_settles_about_the_join_and_is_left_alone_elsewhere() {
+        // A root hopping 10 cm every 6 frames: about 1.1 cm per frame² at each turn.
+        let mut frames: Vec<Pose> = (0..60)
+            .map(|f| {
+                let mut p = Pose {
+                    rotations: vec![glam::Quat::IDENTITY],
+                    translations: vec![Vec3::ZERO],
+                };
+                let phase = (f % 6) as f32 / 6.0;
+                p.translations[0] =
+                    Vec3::new(0.0, 0.9 + 0.1 * (1.0 - (2.0 * phase - 1.0).abs()), 0.0);
+                p
+            })
+            .collect();
+        let before: Vec<Vec3> = frames.iter().map(|p| p.translations[0]).collect();
+        let accel = |fr: &[Pose], f: usize| {
+            (fr[f + 1].translations[0] - 2.0 * fr[f].translations[0] + fr[f - 1].translations[0])
+                .length()
+        };
+        assert!(accel(&frames, 30) > 0.03);
+        let passes = calm_root(&mut frames, 30, 2, 0.005);
+        assert!(passes > 0 && passes < CALM_PASSES, "{passes}");
+        for f in 28..=32 {
+            assert!(
+                accel(&frames, f) <= 0.005,
+                "frame {f}: {}",
+                accel(&frames, f)
+            );
+        }
+        // Beyond the fade the hop is as it was.
+        for f in (0..20).chain(41..60) {
+            assert_eq!(frames[f].translations[0], before[f], "frame {f}");
+        }
     }
 }
