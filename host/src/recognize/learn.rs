@@ -824,7 +824,8 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
     }
 }
 
-/// The translations (strokes) of a gesture's mandatory runs, in order (none for a pure turn).
+/// The translation halves (strokes) of a gesture's mandatory runs, in order ([`NONE_BIN`] for a
+/// run that only turned).
 fn strokes(s: &Tokenized) -> Vec<u16> {
     mandatory_runs(s)
         .iter()
