@@ -262,6 +262,18 @@ mod tests {
         }
     }
 
+    /// `clip` with neutral effort, played whole.
+    fn neutral(clip: &Clip) -> EffortClip {
+        apply_effort(
+            clip,
+            &Phrasing::whole(clip),
+            Effort::default(),
+            Vec3::X,
+            false,
+            None,
+        )
+    }
+
     fn fastest(ec: &EffortClip, seconds: f32) -> f32 {
         let n = (seconds * 30.0).round() as usize;
         let poses: Vec<Pose> = (0..=n).map(|k| ec.pose(k as f32 / n as f32)).collect();
@@ -270,15 +282,7 @@ mod tests {
 
     #[test]
     fn a_lunge_too_fast_for_a_person_borrows_time_from_its_stillness() {
-        let clip = lunge();
-        let ec = apply_effort(
-            &clip,
-            &Phrasing::whole(&clip),
-            Effort::default(),
-            Vec3::X,
-            false,
-            None,
-        );
+        let ec = neutral(&lunge());
         // Played over 1.05 s (2× fast) the lunge moves at 12 m/s.
         assert!(fastest(&ec, 1.05) > 10.0, "{}", fastest(&ec, 1.05));
         let (paced, seconds) = ec.paced(1.05, &speed(4.0));
@@ -337,15 +341,7 @@ mod tests {
 
     #[test]
     fn a_squat_squeezed_into_a_short_event_takes_the_time_its_acceleration_needs() {
-        let clip = squat();
-        let ec = apply_effort(
-            &clip,
-            &Phrasing::whole(&clip),
-            Effort::default(),
-            Vec3::X,
-            false,
-            None,
-        );
+        let ec = neutral(&squat());
         // Squeezed 8× it would accelerate at 64 × 5.9 ≈ 380 m/s².
         assert!(hardest(&ec, 0.125) > 300.0, "{}", hardest(&ec, 0.125));
         let limits = PaceLimits {
