@@ -73,6 +73,14 @@ fn measures(r: &Plausibility) -> [(&'static str, f32, f32); 7] {
     ]
 }
 
+/// The largest `measure` among the reference takes that sit within the envelope.
+fn most_within_envelope(rows: &[Plausibility], measure: impl Fn(&Plausibility) -> f32) -> f32 {
+    rows.iter()
+        .filter(|r| r.beyond().is_empty())
+        .map(measure)
+        .fold(0.0f32, f32::max)
+}
+
 /// The bound on the root's acceleration at joins is the real takes' own: the largest 95th
 /// percentile of root acceleration among the takes within the rest of the envelope.
 #[test]
@@ -81,11 +89,7 @@ fn the_bound_on_pops_at_joins_is_what_real_takes_reach() {
         eprintln!("skipping: no motion capture — run `cargo xtask setup`");
         return;
     };
-    let highest = rows
-        .iter()
-        .filter(|r| r.beyond().is_empty())
-        .map(|r| r.root_accel_p95)
-        .fold(0.0f32, f32::max);
+    let highest = most_within_envelope(&rows, |r| r.root_accel_p95);
     assert!(
         (highest - envelope::ROOT_ACCEL_JOIN_M_S2).abs() < 1.0,
         "real takes within the envelope reach {highest} m/s² (95th percentile)"
@@ -100,11 +104,7 @@ fn the_bound_on_a_squeezed_roots_acceleration_is_what_real_takes_reach() {
         eprintln!("skipping: no motion capture — run `cargo xtask setup`");
         return;
     };
-    let hardest = rows
-        .iter()
-        .filter(|r| r.beyond().is_empty())
-        .map(|r| r.root_accel_max)
-        .fold(0.0f32, f32::max);
+    let hardest = most_within_envelope(&rows, |r| r.root_accel_max);
     assert!(
         (hardest - HUMAN_ROOT_ACCEL_M_S2).abs() < 1.0,
         "real takes within the envelope reach {hardest} m/s²"
