@@ -76,9 +76,17 @@ pub(crate) enum Follow {
 // Out of line: commits only, and for flash. One pass over the runs from `h`'s start to `c`'s
 // end gathers all it needs.
 #[inline(never)]
-pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate) -> Follow {
+pub(crate) fn follow(
+    lib: &Library<'_>,
+    hist: &History,
+    h: &Held,
+    c: &Candidate,
+    late: bool,
+) -> Follow {
     let mut tok = [STILL; HISTORY_RUNS];
     let (mut n, mut between, mut mine) = (0usize, 0usize, 0.0f32);
+    // Moving tokens before `c`'s first.
+    let mut before_c = 0usize;
     // A held event too long to read whole with what follows (a long walk) is read from its
     // end: a next cycle still continues it, a settling is still one.
     let mut whole = c.end.wrapping_sub(h.start_run) < HISTORY_RUNS as u32;
@@ -101,6 +109,9 @@ pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate)
                     mine += motion(&r.acc);
                 }
                 if moving {
+                    if !in_c {
+                        before_c = n + 1;
+                    }
                     match tok.get_mut(n) {
                         Some(t) => *t = r.token,
                         None => whole = false,
@@ -120,15 +131,32 @@ pub(crate) fn follow(lib: &Library<'_>, hist: &History, h: &Held, c: &Candidate)
     if between > CONTINUE_GAP_RUNS {
         return Follow::New;
     }
-    // The held action's whole match over both.
-    let cost = lib
-        .pattern(usize::from(h.action))
-        .filter(|_| whole)
-        .and_then(|p| {
-            let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
-            let tokens: &[Token] = tok.get(..n)?;
-            weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, n.max(p.min_len())))
-        });
+    // The held action's whole match over tokens `tok[from..n]`.
+    let held_cost = |from: usize| {
+        lib.pattern(usize::from(h.action))
+            .filter(|_| whole)
+            .and_then(|p| {
+                let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
+                let tokens: &[Token] = tok.get(from..n)?;
+                let len = tokens.len().max(p.min_len());
+                weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, len))
+            })
+    };
+    let cost = held_cost(0);
+    if late {
+        // After a longer stillness than any pause inside an action: only what finishes a
+        // hold its action's examples made, never a repetition of the held action.
+        return match cost {
+            Some(v)
+                if h.action != c.action
+                    && v < h.cost.saturating_add(c.cost)
+                    && held_cost(before_c).is_none() =>
+            {
+                Follow::Completes(v)
+            }
+            _ => Follow::New,
+        };
+    }
     if h.action == c.action {
         // One match over both must be no worse than the two apart: two jumps with a breath
         // between are two jumps, even when one jump's edit budget could swallow the second.
@@ -210,7 +238,7 @@ mod tests {
         let (hist, o) = history(&[(".Yn", 1.0), ("_", 0.0), (".Yn", 1.0)]);
         let h = held(&hist, 0, o, o, 0);
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(0, o + 2, o + 2, false)),
+            follow(&lib, &hist, &h, &cand(0, o + 2, o + 2, false), false),
             Follow::Continues
         );
         // Two punches are two: `b f b b f b` is no punch.
@@ -225,12 +253,12 @@ mod tests {
         ]);
         let h = held(&hist, 1, o, o + 2, 0);
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, false)),
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, false), false),
             Follow::New
         );
         // … unless the action is cyclic: its next cycle continues it.
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, true)),
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 6, true), false),
             Follow::Continues
         );
     }
@@ -252,7 +280,7 @@ mod tests {
         ]);
         let h = held(&hist, 0, o, o + 2, 0);
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(0, o + 4, o + 6, false)),
+            follow(&lib, &hist, &h, &cand(0, o + 4, o + 6, false), false),
             Follow::New
         );
         // A first piece that was itself a poor match (two edits) is completed by the second.
@@ -260,7 +288,7 @@ mod tests {
         let mut h = held(&hist, 0, o, o, 2 * FULL);
         h.distance = 2;
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(0, o + 2, o + 3, false)),
+            follow(&lib, &hist, &h, &cand(0, o + 2, o + 3, false), false),
             Follow::Continues
         );
     }
@@ -278,7 +306,7 @@ mod tests {
         let (hist, o) = history(&runs);
         assert!(hist.get(o).is_none());
         let h = held(&hist, 0, o, o + 41, 0);
-        let next = |cyclic| follow(&lib, &hist, &h, &cand(0, o + 43, o + 44, cyclic));
+        let next = |cyclic| follow(&lib, &hist, &h, &cand(0, o + 43, o + 44, cyclic), false);
         // Its next cycle continues it; a one-shot action cannot be read whole: a new event.
         assert_eq!(next(true), Follow::Continues);
         assert_eq!(next(false), Follow::New);
@@ -294,20 +322,59 @@ mod tests {
         let h = held(&hist, 0, o, o + 1, FULL);
         let rest = cand(1, o + 3, o + 4, false);
         // `ub f db u`: one added stroke, where the throw alone had one left out: not cheaper.
-        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::New);
+        assert_eq!(follow(&lib, &hist, &h, &rest, false), Follow::New);
         // … unless that other reading needed more edits than the throw over both does: one
         // match no worse than the two apart (a walk's next stride first read as a poor kick).
         let poor = Candidate {
             cost: 2 * FULL,
             ..rest
         };
-        assert_eq!(follow(&lib, &hist, &h, &poor), Follow::Completes(FULL));
+        assert_eq!(
+            follow(&lib, &hist, &h, &poor, false),
+            Follow::Completes(FULL)
+        );
         // Its return alone (`db`) completes it exactly.
         let rest = cand(1, o + 3, o + 3, false);
-        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::Completes(0));
+        assert_eq!(follow(&lib, &hist, &h, &rest, false), Follow::Completes(0));
         // Not when the held match was exact already.
         let h = held(&hist, 0, o, o + 1, 0);
-        assert_eq!(follow(&lib, &hist, &h, &rest), Follow::New);
+        assert_eq!(follow(&lib, &hist, &h, &rest, false), Follow::New);
+    }
+
+    #[test]
+    fn after_a_long_hold_only_the_held_actions_rest_continues_it() {
+        // 0 crouch `d+ u+`, 1 `u+ r+` (a hop aside), 2 `d+ u+`.
+        let blob = seq_library(&[(&["d", "u"], 0), (&["u", "r"], 0), (&["d", "u"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // The crouch was committed at its descent (its rise left out: one edit).
+        let (hist, o) = history(&[("d", 1.0), ("_", 0.0), ("u", 1.0), ("r", 1.0)]);
+        let h = held(&hist, 0, o, o, FULL);
+        // Risen from after a hold longer than the usual pause: `d _ u` is one crouch, cheaper
+        // than the crouch that left its rise out and a hop that added a stroke.
+        let rise = Candidate {
+            cost: FULL,
+            ..cand(1, o + 2, o + 3, false)
+        };
+        let late = |c: &Candidate| follow(&lib, &hist, &h, c, true);
+        assert_eq!(late(&rise), Follow::New, "`d u r` is no crouch");
+        let rise = Candidate {
+            cost: FULL,
+            ..cand(1, o + 2, o + 2, false)
+        };
+        assert_eq!(late(&rise), Follow::Completes(0));
+        // A whole second crouch after the hold is a repetition, whatever reads it.
+        let (hist, o) = history(&[("d", 1.0), ("_", 0.0), ("d", 1.0), ("u", 1.0)]);
+        let h = held(&hist, 0, o, o, FULL);
+        let again = Candidate {
+            cost: FULL,
+            ..cand(2, o + 2, o + 3, false)
+        };
+        assert_eq!(follow(&lib, &hist, &h, &again, true), Follow::New);
+        // The same action again is never its next piece after a long hold.
+        assert_eq!(
+            follow(&lib, &hist, &h, &cand(0, o + 2, o + 3, false), true),
+            Follow::New
+        );
     }
 
     #[test]
@@ -329,14 +396,14 @@ mod tests {
         let (hist, o) = jump_then(2.0);
         let h = held(&hist, 0, o, o + 2, 0);
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false)),
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false), false),
             Follow::Settles
         );
         // A real crouch, 2 × 6 against 45: an action.
         let (hist, o) = jump_then(6.0);
         let h = held(&hist, 0, o, o + 2, 0);
         assert_eq!(
-            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false)),
+            follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false), false),
             Follow::New
         );
     }
@@ -352,7 +419,13 @@ mod tests {
             let (hist, o) = history(&runs);
             let h = held(&hist, 0, o, o + 2, 0);
             let n = between.len() as u32;
-            follow(&lib, &hist, &h, &cand(1, o + 3 + n, o + 4 + n, false))
+            follow(
+                &lib,
+                &hist,
+                &h,
+                &cand(1, o + 3 + n, o + 4 + n, false),
+                false,
+            )
         };
         // Up to CONTINUE_GAP_RUNS strokes between: still its settling.
         assert_eq!(with_between(&["_", "f", "b", "_"]), Follow::Settles);

@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (6; version 5, whose shape table has only the first 13
-//!         bytes of each entry, is still read and its extents are not known; versions 4, 3 and
+//! 0   4   magic "FGL" + version byte (7; version 6, whose shape table has only the first 15
+//!         bytes of each entry, is still read and its holds are not known; version 5, with
+//!         only 13, is still read and its extents are not known either; versions 4, 3 and
 //!         2, with only 7, 6 and 4 bytes, and version 1, without the table, are still read —
 //!         their shapes are not used)
 //! 4   1   n_actions (≤ MAX_ACTIONS)
@@ -26,8 +27,9 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 15 bytes per action in record order (the mean of its examples'
-//! shapes, `features::Shape`, how far they lay from it, and how far the least of them went):
+//! then the shape table, 16 bytes per action in record order (the mean of its examples'
+//! shapes, `features::Shape`, how far they lay from it, how far the least of them went and
+//! how long they held still inside):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
 //! +3  1   0 = shape unknown (all fifteen bytes are zero); otherwise shape known (learnt
@@ -42,6 +44,8 @@
 //!         `extent::to_byte` in `extent::MOVED_CODE_UNIT_M`; 0 = not known
 //! +14 1   the least farthest rotation among them, code in `extent::TURNED_CODE_UNIT_RAD`;
 //!         0 = not known (both are known or neither)
+//! +15 1   the longest stillness inside an example (between its first and last motion), in
+//!         [`HOLD_UNIT_US`]; 0 = none or not known
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -59,9 +63,15 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 6;
+pub const LIBRARY_VERSION: u8 = 7;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 15;
+pub const SHAPE_BYTES: usize = 16;
+/// Bytes per action in a version 6 shape table (no hold).
+const SHAPE_BYTES_V6: usize = 15;
+/// Offset of the hold in a shape-table entry.
+const SHAPE_HOLD_AT: usize = 15;
+/// Unit of the learnt hold's byte code, µs (codes 1–255 span 10 ms – 2.55 s).
+pub const HOLD_UNIT_US: u64 = 10_000;
 /// Bytes per action in a version 5 shape table (no extents).
 const SHAPE_BYTES_V5: usize = 13;
 /// Offset of the extents in a shape-table entry.
@@ -82,7 +92,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,136).
+/// Largest valid library blob, bytes (12,168).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -294,6 +304,7 @@ impl<'a> Library<'a> {
             3 => SHAPE_BYTES_V3,
             4 => SHAPE_BYTES_V4,
             5 => SHAPE_BYTES_V5,
+            6 => SHAPE_BYTES_V6,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -367,10 +378,10 @@ impl<'a> Library<'a> {
     /// How far the least of action `i`'s examples went ([`crate::extent`]); None when not
     /// learnt (a version 5 library, or an action learnt without examples).
     pub fn extent(&self, i: usize) -> Option<Extent> {
-        if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES_V6 {
             return None;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_EXTENT_AT;
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_EXTENT_AT;
         match *self.bytes.get(at..at + 2)? {
             [m, t] => Some(Extent {
                 moved_m: from_byte(m, MOVED_CODE_UNIT_M)?,
@@ -378,6 +389,19 @@ impl<'a> Library<'a> {
             }),
             _ => None,
         }
+    }
+
+    /// The longest stillness inside any of action `i`'s examples, µs: how long a performance
+    /// of it may hold still and go on (0 when its examples never held, or not learnt: a
+    /// library older than version 7).
+    pub fn hold_us(&self, i: usize) -> u64 {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES {
+            return 0;
+        }
+        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_HOLD_AT;
+        self.bytes
+            .get(at)
+            .map_or(0, |&b| u64::from(b) * HOLD_UNIT_US)
     }
 
     /// Number of actions.
@@ -558,7 +582,7 @@ pub(crate) mod tests {
                 Some([l, u, f, t, st, h]) => {
                     out.extend([*l, *u, *f, 1, *t, *st, *h]);
                     out.extend([0; SHAPE_DIMS]);
-                    out.extend([0; 2]);
+                    out.extend([0; 3]);
                 }
                 None => out.extend([0; SHAPE_BYTES]),
             }
@@ -579,6 +603,7 @@ pub(crate) mod tests {
             out.extend([
                 to_byte(m, MOVED_CODE_UNIT_M),
                 to_byte(t, TURNED_CODE_UNIT_RAD),
+                0,
             ]);
         }
         out
@@ -651,6 +676,41 @@ pub(crate) mod tests {
         assert!(near(lib.shape(0), want));
         assert_eq!(lib.shape_tolerance(0), [0.0, 0.2, 0.0, 0.0, 0.0, 1.0]);
         assert_eq!(lib.extent(0), None);
+        // Version 6: fifteen bytes per entry, the extents without the hold.
+        let mut v6 = v1.clone();
+        v6[3] = 6;
+        v6.extend([
+            0,
+            255,
+            51,
+            1,
+            51,
+            255,
+            153,
+            0,
+            51,
+            0,
+            0,
+            0,
+            255,
+            1 + 16 * 10,
+            1 + 16 * 5,
+        ]);
+        v6.extend([0; 15]);
+        let lib = Library::from_bytes(&v6).unwrap();
+        assert!(near(lib.shape(0), want));
+        assert!(lib
+            .extent(0)
+            .is_some_and(|e| (e.moved_m - 0.1024).abs() < 1e-5));
+        assert_eq!(lib.hold_us(0), 0);
+        // The hold, in steps of 10 ms.
+        let mut held = cur.clone();
+        held[entry + SHAPE_HOLD_AT] = 92;
+        let lib = Library::from_bytes(&held).unwrap();
+        assert_eq!(
+            (lib.hold_us(0), lib.hold_us(1), lib.hold_us(2)),
+            (920_000, 0, 0)
+        );
         // The extents, both known or neither.
         assert_eq!(lib_extent(&tol), None);
         let mut ext = tol.clone();

@@ -268,7 +268,11 @@ impl<'lib> Recognizer<'lib> {
                         self.commit(c, &mut emit);
                     }
                 }
-                if still >= CONTINUE_US {
+                // As long as its action's examples held still inside, and no shorter.
+                let keep = self.held.map_or(CONTINUE_US, |h| {
+                    CONTINUE_US.max(self.library.hold_us(usize::from(h.action)))
+                });
+                if still >= keep {
                     self.held = None;
                 }
             }
@@ -545,7 +549,14 @@ impl<'lib> Recognizer<'lib> {
         let Some(mut h) = held else {
             return new(ev);
         };
-        match follow(&self.library, self.front.history(), &h, c) {
+        // Past the usual pause, only the rest of a hold its action's examples made (a crouch
+        // held low, then risen from) continues it.
+        let hist = self.front.history();
+        let late = (1..c.start.wrapping_sub(h.end_run))
+            .take(HISTORY_RUNS)
+            .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
+            .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
+        match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
             Follow::Settles => return None,
             Follow::Continues => h.distance = h.distance.max(c.distance()),

@@ -145,6 +145,16 @@ fn extent_of_runs(g: &[Run]) -> Extent {
     sums.extent()
 }
 
+/// The longest stillness inside any of the gestures (each from its first to its last motion),
+/// seconds; None when none held still inside.
+pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<f32> {
+    gestures
+        .into_iter()
+        .flat_map(|g| g.iter().filter(|r| r.token == STILL))
+        .map(|r| run_seconds(r) as f32)
+        .reduce(f32::max)
+}
+
 /// The least extent among gestures that moved, dimension by dimension: how far the least of
 /// an action's examples went, what the device holds a performance to
 /// ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
@@ -967,7 +977,8 @@ pub fn learn_action(
     )?
     .with_shape(mean_shape(&shapes))
     .with_shape_tolerance(shape_tolerance(&shapes))
-    .with_extent(least_extent(read.iter().map(|e| &e.runs[..])));
+    .with_extent(least_extent(read.iter().map(|e| &e.runs[..])))
+    .with_hold(longest_hold(read.iter().map(|e| &e.runs[..])));
     Ok(entry)
 }
 

@@ -15,7 +15,7 @@ use figurine_recognizer::automaton::{earliest_start, MatcherBank};
 use figurine_recognizer::extent::{to_byte, Extent, MOVED_CODE_UNIT_M, TURNED_CODE_UNIT_RAD};
 use figurine_recognizer::features::Shape;
 use figurine_recognizer::pattern::{
-    LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES, SHAPE_TURN_MAX,
+    HOLD_UNIT_US, LIBRARY_HEADER, LIBRARY_VERSION, MAX_ACTIONS, SHAPE_BYTES, SHAPE_TURN_MAX,
 };
 use figurine_recognizer::token::{parse_token, Token, TokenName};
 use figurine_recognizer::Library;
@@ -76,6 +76,12 @@ pub struct ActionEntry {
     /// action; absent for a pattern written by hand or learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extent: Option<[f32; 2]>,
+    /// The longest stillness inside any example, between its first and last motion, s: how
+    /// long a performance may hold and go on (a crouch held low, then risen from). The device
+    /// keeps the event open for a continuation that long; absent when no example held, for a
+    /// pattern written by hand, or learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hold_s: Option<f32>,
 }
 
 /// Human-readable compiled automaton.
@@ -162,6 +168,7 @@ impl ActionEntry {
             shape_tolerance: None,
             shape_spread: None,
             extent: None,
+            hold_s: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
@@ -193,6 +200,12 @@ impl ActionEntry {
     pub fn with_shape_tolerance(mut self, tolerance: Option<[f32; 6]>) -> Self {
         self.shape_tolerance = tolerance;
         self.shape_spread = None;
+        self
+    }
+
+    /// The same entry with the examples' longest hold `hold_s` (see [`ActionEntry::hold_s`]).
+    pub fn with_hold(mut self, hold_s: Option<f32>) -> Self {
+        self.hold_s = hold_s.filter(|h| h.is_finite() && *h > 0.0);
         self
     }
 
@@ -238,6 +251,7 @@ impl ActionEntry {
                     q(tol[5]),
                     extent.map_or(0, |e| to_byte(e[0], MOVED_CODE_UNIT_M)),
                     extent.map_or(0, |e| to_byte(e[1], TURNED_CODE_UNIT_RAD)),
+                    duration_byte(self.hold_s),
                 ]
             }
             _ => [0; SHAPE_BYTES],
@@ -371,6 +385,15 @@ pub fn full_match(entry: &ActionEntry, tokens: &[Token]) -> Result<Option<u8>> {
         }
     }
     Ok(None)
+}
+
+/// A duration, s, as the shape table's byte in `HOLD_UNIT_US` steps (0: none).
+fn duration_byte(d: Option<f32>) -> u8 {
+    d.map_or(0, |d| {
+        (f64::from(d) * 1e6 / HOLD_UNIT_US as f64)
+            .round()
+            .clamp(0.0, 255.0) as u8
+    })
 }
 
 #[cfg(test)]
