@@ -8,7 +8,7 @@
 //! | penetration | depth of a foot's lowest point below the ground: mean over frames, max | mm |
 //! | airborne | longest stretch with no foot within [`NEAR_GROUND_M`] of the ground | s |
 //! | skating | horizontal speed of a foot's lowest point while it is within [`CONTACT_M`] of the ground: median, share above [`SKATE_M_S`] | cm/s, % |
-//! | torso tilt | angle of hips → neck from vertical: 95th percentile, max | ° |
+//! | torso tilt | angle of hips → neck from vertical: 95th percentile, max; an assembled animation's, per action, against the real takes of its kind ([`super::tilt_reference`]) | ° |
 //! | knee bent backwards | the thigh–shin bend about the hips' right axis (a knee folds the shin back, about their left): max | ° |
 //! | elbow bent backwards | in the upper arm's frame, the bend about the opposite of the axis the elbow folds about when well bent over the clip: max | ° |
 //! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
@@ -594,7 +594,8 @@ pub fn print_tilt_reference(tilt: &TiltReference) {
 /// Prints the figures of `rows` as a table, one clip a line.
 pub fn print_table(rows: &[Plausibility]) {
     println!(
-        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13} {:>10}  {}",
+        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13} {:>10}  action's tilt \
+         in its kind's p95/max range",
         "clip",
         "s",
         "penetr. mm",
@@ -606,7 +607,6 @@ pub fn print_table(rows: &[Plausibility]) {
         "root m/s",
         "root m/s²",
         "joins m/s²",
-        "action's tilt in its kind's p95/max range"
     );
     // (The measures beyond the envelope follow each row.)
     for r in rows {
