@@ -519,7 +519,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     println!(
         "within the real-mocap envelope (penetration ≤ {} mm, airborne ≤ {} s, contact-foot \
          speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s, ≤ {} m/s² at joins, \
-         torso tilt within its kind's range): {within} of {}",
+         an assembled action's torso tilt within its kind's range): {within} of {}",
         envelope::PENETRATION_MM,
         envelope::AIRBORNE_S,
         envelope::SKATE_CM_S,
