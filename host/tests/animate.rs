@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use figurine_host::anim::assemble::{assemble, AssembleOptions, Assembly};
 use figurine_host::anim::effort::spine_lean;
+use figurine_host::anim::joint_limits::JointRanges;
 use figurine_host::anim::library::ClipLibrary;
 use figurine_host::anim::phrasing::Stage;
 use figurine_host::anim::trajectory::ground;
@@ -381,6 +382,111 @@ fn strong_moves_wider_and_bends_lower_than_light() {
         let d = tilt(&strong) - tilt(&light);
         assert!(d > 0.18 && d < 0.37, "{action}: {d}");
     }
+}
+
+/// The joints [`Assembly::limb_swing_rad`] averages.
+const LIMB_JOINTS: [&str; 8] = [
+    "right_shoulder",
+    "right_elbow",
+    "left_shoulder",
+    "left_elbow",
+    "right_hip",
+    "right_knee",
+    "left_hip",
+    "left_knee",
+];
+
+/// Per joint of [`LIMB_JOINTS`]: its mean swing (rad) from the action's first frame over the
+/// action, and the share of the action's frames in which swinging it 10 % further from that
+/// pose would leave the range the library's actors moved it in (it is at its range's edge).
+fn swing_by_joint(a: &Assembly, ranges: &JointRanges) -> Vec<(&'static str, f32, f32)> {
+    let sk = &a.clip.skeleton;
+    let p = &a.placements[0];
+    let frames = &a.clip.frames[p.start_frame..=p.end_frame];
+    let q0 = &a.clip.frames[p.start_frame].rotations;
+    LIMB_JOINTS
+        .iter()
+        .filter_map(|&n| Some((n, sk.find(n)?)))
+        .map(|(n, j)| {
+            let swing = frames
+                .iter()
+                .map(|f| q0[j].angle_between(f.rotations[j]))
+                .sum::<f32>()
+                / frames.len() as f32;
+            let at_edge = frames
+                .iter()
+                .filter(|f| {
+                    let d = f.rotations[j] * q0[j].inverse();
+                    let d = if d.w < 0.0 { -d } else { d };
+                    let (axis, angle) = d.to_axis_angle();
+                    angle > 0.05
+                        && !ranges.contains(j, Quat::from_axis_angle(axis, angle * 1.1) * q0[j])
+                })
+                .count() as f32
+                / frames.len() as f32;
+            (n, swing, at_edge)
+        })
+        .collect()
+}
+
+/// Where a strong kick's swing is held: per joint, its swing light / neutral / strong and
+/// how often it sits at the edge of the library's range. Eq. 7 scales every joint's swing by
+/// c = Lw + 1 (1.9 at Lw = 0.9); a joint at its range's edge gains less. The strong kick's
+/// amplitude beside the light one's is issue 29's effort contrast (README, "Is the animation
+/// believable?").
+#[test]
+fn a_strong_kicks_swing_is_held_where_its_joints_meet_their_range() {
+    let Some((_, clips)) = setup() else {
+        return;
+    };
+    let ranges = clips["kick"].ranges.clone().unwrap();
+    let (light, neutral, strong) = (
+        single("kick", 0.0, -0.9),
+        single("kick", 0.0, 0.0),
+        single("kick", 0.0, 0.9),
+    );
+    let (l, n, s) = (
+        swing_by_joint(&light, &ranges),
+        swing_by_joint(&neutral, &ranges),
+        swing_by_joint(&strong, &ranges),
+    );
+    for ((l, n), s) in l.iter().zip(&n).zip(&s) {
+        eprintln!(
+            "kick {:<15} swing light {:.3} neutral {:.3} strong {:.3} rad (strong/neutral {:.2}), \
+             at its range's edge in {:.0} % of the strong kick's frames",
+            l.0,
+            l.1,
+            n.1,
+            s.1,
+            s.1 / n.1.max(1e-6),
+            100.0 * s.2
+        );
+    }
+    let amp = |a: &Assembly| a.limb_swing_rad(0).unwrap_or(0.0);
+    eprintln!(
+        "kick amplitude light {:.3} neutral {:.3} strong {:.3} rad",
+        amp(&light),
+        amp(&neutral),
+        amp(&strong)
+    );
+    // An arm that is rarely at its range's edge (nothing but its range holds an arm: the
+    // legs are drawn back from the floor too) swings well wider strong than neutral, and
+    // neutral than light: eq. 7 acts where there is room.
+    for ((l, n), s) in l.iter().zip(&n).zip(&s) {
+        if (s.0.ends_with("shoulder") || s.0.ends_with("elbow")) && s.2 < 0.1 {
+            assert!(
+                s.1 > 1.3 * n.1 && n.1 > l.1,
+                "{}: {} {} {}",
+                s.0,
+                l.1,
+                n.1,
+                s.1
+            );
+        }
+    }
+    assert!(amp(&strong) > amp(&neutral) && amp(&neutral) > amp(&light));
+    let mean = s.iter().map(|j| j.1).sum::<f32>() / s.len() as f32;
+    assert!((mean - amp(&strong)).abs() < 1e-4, "{mean}");
 }
 
 #[test]

@@ -4,13 +4,14 @@
 use figurine_host::anim::assemble::Assembly;
 use figurine_host::anim::assemble::{assemble, AssembleOptions};
 use figurine_host::anim::check::{
-    accel_near, check_assembly, check_path, check_reference, envelope, Ground, Plausibility,
-    JOIN_WINDOW_S,
+    accel_near, check_assembly, check_path, check_reference, default_tilt_reference, envelope,
+    Ground, Plausibility, JOIN_WINDOW_S,
 };
 use figurine_host::anim::cli::label_events;
 use figurine_host::anim::defaults::default_animations;
 use figurine_host::anim::library::ClipLibrary;
 use figurine_host::anim::pacing::HUMAN_ROOT_ACCEL_M_S2;
+use figurine_host::anim::tilt_reference::vigour_spread;
 use figurine_host::data::data_file;
 use figurine_host::recognize::simulate::effort_words;
 use figurine_host::synth::{sequence, Knobs};
@@ -111,6 +112,26 @@ fn the_bound_on_a_squeezed_roots_acceleration_is_what_real_takes_reach() {
     );
 }
 
+/// The margin an action's torso tilt is judged with is the real takes' own: the widest
+/// spread of tilt (95th percentile or max) among one performer's takes of one kind at
+/// different vigour (LAFAN1's calm, median and wild dance; its stroll, walk and stride).
+#[test]
+fn the_tilt_margin_is_how_far_real_takes_of_one_kind_differ_in_vigour() {
+    let Ok(tilt) = default_tilt_reference() else {
+        eprintln!("skipping: no motion capture — run `cargo xtask setup`");
+        return;
+    };
+    let spread = vigour_spread(&tilt.kinds);
+    assert!(
+        (spread - envelope::TILT_MARGIN_DEG).abs() < 0.1,
+        "one performer's takes of one kind differ by up to {spread}°"
+    );
+    // Every kind of action the default library plays has real takes to judge it by.
+    for action in ClipLibrary::default_library().unwrap().actions.keys() {
+        assert!(tilt.bounds(action).is_some(), "{action}");
+    }
+}
+
 /// The largest root acceleration (m/s²) of an assembled animation away from its joins
 /// (further than [`JOIN_WINDOW_S`] from every one): the actions' own.
 fn accel_away_from_joins(asm: &Assembly) -> f32 {
@@ -121,13 +142,35 @@ fn accel_away_from_joins(asm: &Assembly) -> f32 {
     accel_near(&asm.clip, &away, 0.0)
 }
 
-/// Asserts every measure of `r` within the envelope, pops at joins included.
+/// Asserts every measure of `r` within the envelope, pops at joins included, and every
+/// action's torso tilt (95th percentile and max) within the range of the real takes of its
+/// kind, widened by the measured vigour spread (`figurine_host::anim::torso_tilt`).
 fn assert_within(r: &Plausibility) {
     for (what, value, bound) in measures(r) {
         assert!(
             value <= bound,
             "{}: {what} {value} beyond the envelope's {bound}: {r:?}",
             r.name
+        );
+    }
+    assert!(!r.tilt_by_action.is_empty(), "{}: tilt not judged", r.name);
+    for t in &r.tilt_by_action {
+        let b = t
+            .bounds
+            .unwrap_or_else(|| panic!("{}: no take of {}'s kind", r.name, t.action));
+        assert!(
+            t.holds(),
+            "{}: {}'s torso tilt p95 {:.1}° max {:.1}° beyond its kind's p95 {:.1}-{:.1}° max \
+             {:.1}-{:.1}° (both sides judged: {})",
+            r.name,
+            t.action,
+            t.figures.p95,
+            t.figures.max,
+            b.p95.0,
+            b.p95.1,
+            b.max.0,
+            b.max.1,
+            t.whole
         );
     }
 }
@@ -146,9 +189,14 @@ fn every_default_animation_stays_within_the_envelope() {
         return;
     }
     let (anims, _) = default_animations(5).unwrap();
+    let tilt = default_tilt_reference().unwrap();
     assert_eq!(anims.len(), 60);
     for a in &anims {
-        let r = &check_assembly(&a.assembly, &format!("{} {}", a.action, a.effort)).unwrap();
+        let r = &check_assembly(&a.assembly, &format!("{} {}", a.action, a.effort), &tilt).unwrap();
+        assert!(
+            r.tilt_by_action.iter().all(|t| t.whole),
+            "judged on both sides"
+        );
         assert_within(r);
     }
     eprintln!(
@@ -170,6 +218,7 @@ fn generated_sequences_stay_within_the_envelope() {
         return;
     }
     let library = ClipLibrary::default_library().unwrap();
+    let tilt = default_tilt_reference().unwrap();
     for seed in [1, 2, 3, 4, 5, 2026] {
         let doodle = sequence(seed, &Knobs::default(), 6, None);
         let events = label_events(doodle.labels.clone());
@@ -188,11 +237,11 @@ fn generated_sequences_stay_within_the_envelope() {
             .iter()
             .map(|e| format!("{} {}", e.action, effort_words(e.time, e.weight)))
             .collect();
-        let r = check_assembly(&asm, &format!("sequence {seed}")).unwrap();
+        let r = check_assembly(&asm, &format!("sequence {seed}"), &tilt).unwrap();
         eprintln!(
             "sequence {seed} ({}): penetration {:.1} mm, airborne {:.2} s, skating {:.1} cm/s, \
              knee {:.0}°, elbow {:.0}°, root {:.2} m/s, {:.0} m/s² at joins ({:.0} away, p95 \
-             {:.0})",
+             {:.0}), torso tilt p95/max per action {}",
             played.join(", "),
             r.penetration_max_mm,
             r.airborne_max_s,
@@ -203,6 +252,11 @@ fn generated_sequences_stay_within_the_envelope() {
             r.root_accel_joins_max.unwrap_or(0.0),
             accel_away_from_joins(&asm),
             r.root_accel_p95,
+            r.tilt_by_action
+                .iter()
+                .map(|t| format!("{:.0}/{:.0}", t.figures.p95, t.figures.max))
+                .collect::<Vec<_>>()
+                .join(" "),
         );
         assert_within(&r);
     }

@@ -8,7 +8,7 @@
 //! | penetration | depth of a foot's lowest point below the ground: mean over frames, max | mm |
 //! | airborne | longest stretch with no foot within [`NEAR_GROUND_M`] of the ground | s |
 //! | skating | horizontal speed of a foot's lowest point while it is within [`CONTACT_M`] of the ground: median, share above [`SKATE_M_S`] | cm/s, % |
-//! | torso tilt | angle of hips → neck from vertical: 95th percentile, max | ° |
+//! | torso tilt | angle of hips → neck from vertical: 95th percentile, max; an assembled animation's, per action, against the real takes of its kind ([`super::tilt_reference`]) | ° |
 //! | knee bent backwards | the thigh–shin bend about the hips' right axis (a knee folds the shin back, about their left): max | ° |
 //! | elbow bent backwards | in the upper arm's frame, the bend about the opposite of the axis the elbow folds about when well bent over the clip: max | ° |
 //! | root speed, acceleration | the hips' speed and acceleration (finite differences): 95th percentile, max | m/s, m/s² |
@@ -27,6 +27,8 @@ use clap::Args;
 use glam::{Quat, Vec3};
 use serde::Serialize;
 
+use super::tilt_reference::{TiltJudgement, TiltReference};
+use super::torso_tilt::{tilt_deg, TiltFigures};
 use crate::graph::roles::{Role, RoleMap, RoleOverrides};
 use crate::motion::CENTIMETRE_HEIGHT;
 use crate::motion::{Clip, Skeleton};
@@ -94,6 +96,11 @@ pub struct Plausibility {
     /// Largest root acceleration within [`JOIN_WINDOW_S`] of a join, m/s² (assembled
     /// animations, [`check_assembly`]; `None` for a file, whose joins are not known).
     pub root_accel_joins_max: Option<f32>,
+    /// An assembled animation's torso tilt per placement, against the range of real takes of
+    /// its action's kind ([`super::tilt_reference`]; empty for a file, whose actions are not
+    /// known).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tilt_by_action: Vec<TiltJudgement>,
 }
 
 impl Plausibility {
@@ -118,6 +125,7 @@ impl Plausibility {
                     .is_some_and(|a| a > e::ROOT_ACCEL_JOIN_M_S2),
                 "pops at joins",
             ),
+            (self.tilt_by_action.iter().any(|t| !t.holds()), "torso tilt"),
         ]
         .into_iter()
         .filter_map(|(out, what)| out.then_some(what))
@@ -194,11 +202,18 @@ fn elbow_backwards(arm: &[(Vec3, Vec3)]) -> f32 {
     max_of(arm.iter().map(|&(u, d)| bent_backwards(u, d, axis)))
 }
 
-/// Measures an assembled animation ([`check_clip`] in metres on the ground y = 0), and its
-/// root's acceleration around its joins ([`Plausibility::root_accel_joins_max`]).
-pub fn check_assembly(asm: &super::assemble::Assembly, name: &str) -> Result<Plausibility> {
+/// Measures an assembled animation ([`check_clip`] in metres on the ground y = 0), its
+/// root's acceleration around its joins ([`Plausibility::root_accel_joins_max`]) and each
+/// action's torso tilt against the real takes of its kind in `tilt`
+/// ([`Plausibility::tilt_by_action`]).
+pub fn check_assembly(
+    asm: &super::assemble::Assembly,
+    name: &str,
+    tilt: &TiltReference,
+) -> Result<Plausibility> {
     let mut r = check_clip(&asm.clip, Ground::At(0.0), name)?;
     r.root_accel_joins_max = Some(accel_near(&asm.clip, &asm.joins, JOIN_WINDOW_S));
+    r.tilt_by_action = tilt.judge(asm)?;
     Ok(r)
 }
 
@@ -306,12 +321,9 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
     }
     let skating = contact_speeds.iter().filter(|&&s| s > SKATE_M_S).count();
     let tilt: Vec<f32> = (0..n)
-        .map(|f| {
-            let up = p(f, j(Role::Neck)) - p(f, j(Role::Hips));
-            up.try_normalize()
-                .map_or(0.0, |u| u.dot(Vec3::Y).clamp(-1.0, 1.0).acos().to_degrees())
-        })
+        .map(|f| tilt_deg(p(f, j(Role::Hips)), p(f, j(Role::Neck))))
         .collect();
+    let tilt_figures = TiltFigures::of(&tilt);
     let knee_back = max_of((0..n).flat_map(|f| {
         let left = p(f, j(Role::LeftHip)) - p(f, j(Role::RightHip));
         legs.iter()
@@ -361,8 +373,8 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
         } else {
             100.0 * skating as f32 / contact_speeds.len() as f32
         },
-        tilt_p95_deg: quantile(&tilt, 0.95),
-        tilt_max_deg: max_of(tilt.iter().copied()),
+        tilt_p95_deg: tilt_figures.p95,
+        tilt_max_deg: tilt_figures.max,
         knee_backwards_max_deg: knee_back,
         elbow_backwards_max_deg: elbow_back,
         root_speed_p95: quantile(&speed, 0.95),
@@ -370,6 +382,7 @@ pub fn check_clip(clip: &Clip, ground: Ground, name: &str) -> Result<Plausibilit
         root_accel_p95: quantile(&accel, 0.95),
         root_accel_max: max_of(accel.iter().copied()),
         root_accel_joins_max: None,
+        tilt_by_action: Vec::new(),
     })
 }
 
@@ -406,14 +419,23 @@ pub struct CheckArgs {
 /// Every default action in the four effort corners and neutral, each assembled along a
 /// doodle generated at `seed` from its label (as `figurine animate --labels` does), judged.
 pub fn check_defaults(seed: u64) -> Result<Vec<Plausibility>> {
-    check_animations(&super::defaults::default_animations(seed)?.0)
+    let tilt = default_tilt_reference()?;
+    check_animations(&super::defaults::default_animations(seed)?.0, &tilt)
+}
+
+/// The torso-tilt reference of the default library's actions ([`TiltReference::of_library`]).
+pub fn default_tilt_reference() -> Result<TiltReference> {
+    TiltReference::of_library(&super::library::ClipLibrary::default_library()?)
 }
 
 /// Judges assembled default animations, each labelled "ACTION EFFORT".
-fn check_animations(anims: &[super::defaults::DefaultAnimation]) -> Result<Vec<Plausibility>> {
+fn check_animations(
+    anims: &[super::defaults::DefaultAnimation],
+    tilt: &TiltReference,
+) -> Result<Vec<Plausibility>> {
     anims
         .iter()
-        .map(|a| check_assembly(&a.assembly, &format!("{} {}", a.action, a.effort)))
+        .map(|a| check_assembly(&a.assembly, &format!("{} {}", a.action, a.effort), tilt))
         .collect()
 }
 
@@ -469,9 +491,12 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     if a.reference {
         rows.extend(check_reference()?);
     }
+    let mut tilt_reference = None;
     if a.defaults {
         let (anims, forward) = super::defaults::default_animations(a.seed)?;
-        rows.extend(check_animations(&anims)?);
+        let tilt = default_tilt_reference()?;
+        rows.extend(check_animations(&anims, &tilt)?);
+        tilt_reference = Some(tilt);
         if let Some(dir) = &a.sheets {
             let written = super::defaults::write_effort_sheets(&anims, forward, dir)?;
             eprintln!("{} effort sheets in {}", written.len(), dir.display());
@@ -487,11 +512,14 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         return Ok(());
     }
     print_table(&rows);
+    if let Some(tilt) = &tilt_reference {
+        print_tilt_reference(tilt);
+    }
     let within = rows.iter().filter(|r| r.beyond().is_empty()).count();
     println!(
         "within the real-mocap envelope (penetration ≤ {} mm, airborne ≤ {} s, contact-foot \
-         speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s, ≤ {} m/s² at joins): \
-         {within} of {}",
+         speed ≤ {} cm/s, knees and elbows backwards ≤ {}°, root ≤ {} m/s, ≤ {} m/s² at joins, \
+         an assembled action's torso tilt within its kind's range): {within} of {}",
         envelope::PENETRATION_MM,
         envelope::AIRBORNE_S,
         envelope::SKATE_CM_S,
@@ -513,10 +541,61 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     Ok(())
 }
 
+/// The tilt column of a row: for one action, its tilt p95/max over its own frames, the
+/// ranges of its kind and whether it holds; for several, how many hold; `-` for a file.
+fn tilt_column(judged: &[TiltJudgement]) -> String {
+    match judged {
+        [] => "-".into(),
+        [one] => match one.bounds {
+            None => "no take of its kind".into(),
+            Some(b) => format!(
+                "{:.0}/{:.0} in {:.0}-{:.0}/{:.0}-{:.0} {}",
+                one.figures.p95,
+                one.figures.max,
+                b.p95.0,
+                b.p95.1,
+                b.max.0,
+                b.max.1,
+                if one.holds() { "ok" } else { "OUT" }
+            ),
+        },
+        many => {
+            let ok = many.iter().filter(|t| t.holds()).count();
+            format!("{ok} of {} actions below their kind's top", many.len())
+        }
+    }
+}
+
+/// Prints the real takes of each kind of action, their tilt, and the range an assembled
+/// animation of that kind is held to.
+pub fn print_tilt_reference(tilt: &TiltReference) {
+    println!(
+        "torso tilt of the real takes of each kind (p95/max °), ranges widened by {:.1}° (the \
+         widest spread among one performer's takes of one kind at different vigour, measured \
+         {:.2}°):",
+        tilt.margin_deg,
+        super::tilt_reference::vigour_spread(&tilt.kinds)
+    );
+    for (action, takes) in &tilt.kinds {
+        let list: Vec<String> = takes
+            .iter()
+            .map(|t| format!("{} {:.0}/{:.0}", t.source, t.figures.p95, t.figures.max))
+            .collect();
+        let range = tilt.bounds(action).map_or_else(String::new, |b| {
+            format!(
+                " → p95 {:.0}-{:.0}, max {:.0}-{:.0}",
+                b.p95.0, b.p95.1, b.max.0, b.max.1
+            )
+        });
+        println!("  {action:<9} {}{range}", list.join(", "));
+    }
+}
+
 /// Prints the figures of `rows` as a table, one clip a line.
 pub fn print_table(rows: &[Plausibility]) {
     println!(
-        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13} {:>10}",
+        "{:<28} {:>6} {:>13} {:>8} {:>13} {:>11} {:>7} {:>7} {:>11} {:>13} {:>10}  action's tilt \
+         in its kind's p95/max range",
         "clip",
         "s",
         "penetr. mm",
@@ -527,12 +606,12 @@ pub fn print_table(rows: &[Plausibility]) {
         "elbow°",
         "root m/s",
         "root m/s²",
-        "joins m/s²"
+        "joins m/s²",
     );
     // (The measures beyond the envelope follow each row.)
     for r in rows {
         println!(
-            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0} {:>10}",
+            "{:<28} {:>6.1} {:>6.1} {:>6.1} {:>8.2} {:>6.1} {:>6.0} {:>5.0} {:>5.0} {:>7.0} {:>7.0} {:>5.1} {:>5.1} {:>6.0} {:>6.0} {:>10}  {}",
             r.name.chars().take(28).collect::<String>(),
             r.seconds,
             r.penetration_mean_mm,
@@ -550,6 +629,7 @@ pub fn print_table(rows: &[Plausibility]) {
             r.root_accel_max,
             r.root_accel_joins_max
                 .map_or_else(|| "-".to_string(), |a| format!("{a:.0}")),
+            tilt_column(&r.tilt_by_action),
         );
         let beyond = r.beyond();
         if !beyond.is_empty() {

@@ -18,7 +18,9 @@
 //!   speed is uniform). Then eq. 7 over every stage with `c = Lw + 1` (strong) or `1 / (1 − Lw)`
 //!   (light); then reshaping: every spine bone (the chain from the root to the head, found
 //!   automatically) is rotated by `δθ = 0.1 · Lw` rad about the body's lateral axis, strong
-//!   sinking forward, light rising.
+//!   sinking forward, light rising; each frame's torso tilt is then held within
+//!   [`super::torso_tilt::HOLD_DEG`] of its source frame's
+//!   ([`super::torso_tilt::hold_torso_tilt`]).
 //!
 //! Eq. 7 is applied with each stage's reference chained to the previous stage's rescaled end,
 //! so the rescaled motion stays continuous at stage boundaries. Every joint is rescaled only
@@ -40,6 +42,7 @@ use glam::{Quat, Vec3};
 use super::contact::{find_legs, keep_feet_above_floor, keep_source_contacts};
 use super::joint_limits::{find_hinges, limit_hinges, JointRanges};
 use super::phrasing::{Phrasing, Stage};
+use super::torso_tilt::{hold_torso_tilt, HOLD_DEG};
 use crate::motion::{Clip, Pose, Skeleton};
 
 /// Exponent of the weight arc-length reparametrisation (seed: α = 1.5).
@@ -199,6 +202,9 @@ pub fn apply_effort(
     keep_source_contacts(clip, &mut out);
     keep_feet_above_floor(clip, &mut out);
     reshape(&mut out, e.weight, forward);
+    // Bent further or straighter, the torso stays within the tilt real takes of one kind
+    // vary by at different vigour (a light bow still bows).
+    hold_torso_tilt(clip, &mut out, HOLD_DEG);
 
     // Time maps: weight arc length G (source → arc clock), then eq. 6 stages F.
     let speeds = joint_speeds(clip);

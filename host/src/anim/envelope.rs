@@ -19,3 +19,9 @@ pub const ROOT_SPEED_M_S: f32 = 4.2;
 /// (DeepMimic's kick, 28 m/s²; people walking 4–10, dancing 13). A join may move the root as
 /// sharply as a kick does, no more.
 pub const ROOT_ACCEL_JOIN_M_S2: f32 = 28.0;
+/// Torso tilt, °: how far a frame's tilt may differ from its source frame's, and how far an
+/// action's tilt (95th percentile, max) may lie outside the range of the real takes of its
+/// kind ([`super::tilt_reference`]): the widest spread among one performer's takes of one
+/// kind at different vigour (LAFAN1's dance, calm 16° to wild 28° at the 95th percentile;
+/// its walks 5–13°).
+pub const TILT_MARGIN_DEG: f32 = 11.6;

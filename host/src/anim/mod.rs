@@ -18,7 +18,9 @@
 //! [`assemble`] (the whole pipeline) → [`cli`] (`figurine animate`, `figurine clip stages|plot|variants`).
 //! [`plot`] draws contact sheets to look at the result; [`check`] (`figurine check`) judges
 //! it against real motion capture (penetration, floating, skating, joints bent backwards)
-//! within the bounds of [`envelope`], which [`pacing`] holds a path to as well. [`sideways`]
+//! within the bounds of [`envelope`], which [`pacing`] holds a path to as well, and each
+//! action's torso tilt against the real takes of its kind ([`tilt_reference`]; measured by
+//! [`torso_tilt`], which effort transfer holds a frame's tilt with). [`sideways`]
 //! (`figurine clip sideways`) searches takes for sideways stepping to cut a sidestep from.
 
 use std::path::PathBuf;
@@ -46,6 +48,8 @@ pub mod phrasing;
 pub mod plot;
 pub mod retarget;
 pub mod sideways;
+pub mod tilt_reference;
+pub mod torso_tilt;
 pub mod trajectory;
 pub mod transition;
 pub mod variant_effort;
