@@ -149,7 +149,7 @@ pub(crate) fn follow(
         return match cost {
             Some(v)
                 if h.action != c.action
-                    && v < h.cost.saturating_add(c.cost)
+                    && v <= h.cost.saturating_add(c.cost)
                     && held_cost(before_c).is_none() =>
             {
                 Follow::Completes(v)

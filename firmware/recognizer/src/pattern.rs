@@ -572,6 +572,25 @@ pub(crate) mod tests {
         out
     }
 
+    /// A library of sequential patterns `t1+ t2+ …` whose tokens from the `end`-th (1-based)
+    /// on are optional (`d+ u*` for `(&["d", "u"], 0, 1)`), for tests.
+    pub fn seq_library_ending(actions: &[(&[&str], u8, usize)]) -> Vec<u8> {
+        let mut out = Vec::from(*b"FGL\x01");
+        out.extend([actions.len() as u8, 0, 0, 0]);
+        for (toks, k, end) in actions {
+            let syms: Vec<Token> = toks.iter().map(|t| parse_token(t).unwrap()).collect();
+            let n = syms.len();
+            let mut follow = std::vec![0u64; n + 1];
+            follow[0] = 1 << 1;
+            for (i, f) in follow.iter_mut().enumerate().skip(1) {
+                *f = (1 << i) | if i < n { 1 << (i + 1) } else { 0 };
+            }
+            let last = (*end..=n).fold(0u64, |m, i| m | 1 << i);
+            encode_record(&mut out, &syms, &follow, last, *k, false).unwrap();
+        }
+        out
+    }
+
     /// `blob` (version 1) as the current version with a shape table (`None`: unknown), each
     /// known shape with tolerance 0 in every dimension.
     pub fn with_shapes(blob: &[u8], shapes: &[Option<[u8; 6]>]) -> Vec<u8> {
@@ -606,6 +625,16 @@ pub(crate) mod tests {
                 0,
             ]);
         }
+        out
+    }
+
+    /// `blob` (the current version, with its shape table) with action `i`'s learnt hold set
+    /// to `hold_us` (rounded down to [`HOLD_UNIT_US`]).
+    pub fn with_hold(blob: &[u8], i: usize, hold_us: u64) -> Vec<u8> {
+        let mut out = blob.to_vec();
+        let n = usize::from(out[4]);
+        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_HOLD_AT;
+        out[at] = (hold_us / HOLD_UNIT_US).min(255) as u8;
         out
     }
 

@@ -1182,6 +1182,30 @@ mod tests {
     }
 
     #[test]
+    fn a_crouch_held_as_long_as_its_examples_held_is_one_crouch() {
+        // 0 crouch `d.Xp+ d+ u*` (its pitched descent alone is one, exactly), 1 a rise `u+`.
+        // Held low for a second: the crouch is committed at its descent.
+        let blob = crate::pattern::tests::seq_library_ending(&[
+            (&["d.Xp", "d", "u"], 0, 2),
+            (&["u"], 0, 1),
+        ]);
+        let blob = crate::pattern::tests::with_extents(&blob, &[(0.01, 0.01), (0.01, 0.01)]);
+        let low = crouch_held_low(1.0);
+        let read = |blob: &[u8]| {
+            let lib = Library::from_bytes(blob).unwrap();
+            run(&lib, &low)
+                .iter()
+                .map(|e| (e.action, e.revises))
+                .collect::<Vec<_>>()
+        };
+        // Not learnt to hold that long: the rise is a gesture of its own.
+        assert_eq!(read(&blob), [(0, false), (1, false)]);
+        // Its examples held 1.1 s: the rise finishes the crouch, reported as its revision.
+        let held = crate::pattern::tests::with_hold(&blob, 0, 1_100_000);
+        assert_eq!(read(&held), [(0, false), (0, true)]);
+    }
+
+    #[test]
     fn a_match_that_needed_an_edit_waits_for_a_closer_one_begun_inside_it() {
         // A sideways stroke just before a pitched descent: "jump" explains `r d.Xp d` by
         // leaving its hop out (a whole edit); "crouch" began at the descent, half an edit off
