@@ -60,6 +60,10 @@ pub struct BenchArgs {
     /// The box rig's depth (front to back, its Z), metres.
     #[arg(long, default_value_t = DEFAULT_BOX_M)]
     pub box_depth: f64,
+    /// With `--rig box`: a fifth tag on the box's top, this high above the side tags' centres
+    /// (metres; the box is drawn that tall).
+    #[arg(long, requires = "rig")]
+    pub box_top: Option<f64>,
     /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
@@ -233,7 +237,10 @@ fn read_truths(path: &std::path::Path, setup: &Setup, scene: &Scene) -> Result<V
 /// The first line of a kept video's truths: the setup it was drawn with.
 fn truths_head(setup: &Setup) -> String {
     let rig = setup.rig_box.map_or(String::new(), |b| {
-        format!(", box {} × {} m", b.width, b.depth)
+        let top = b
+            .top
+            .map_or(String::new(), |h| format!(", top tag {h} m up"));
+        format!(", box {} × {} m{top}", b.width, b.depth)
     });
     format!(
         "# tag {} m at {} m, seed {}{rig}",
@@ -388,10 +395,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let rig_box = args.rig.as_ref().map(|_| BoxSize {
         width: args.box_width,
         depth: args.box_depth,
+        top: args.box_top,
     });
     if let Some(b) = rig_box {
-        let rig =
-            super::rig::Rig::checked_box(Family::Tag36h11, 0, args.tag_size, b.width, b.depth)?;
+        let rig = super::rig::Rig::checked_box(Family::Tag36h11, 0, args.tag_size, b)?;
         eprintln!("a box rig of {} × {} m:", b.width, b.depth);
         for line in rig.describe() {
             eprintln!("  {line}");

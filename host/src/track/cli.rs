@@ -106,6 +106,22 @@ pub struct BoxArgs {
     /// The box rig's depth (front to back, its Z: its left and right faces), metres.
     #[arg(long, default_value_t = DEFAULT_BOX_M)]
     pub box_depth: f64,
+    /// A fifth tag (`--tag-id`+4) on the box's top, its printed top toward the figurine's
+    /// back: the top's height above the side tags' centres, metres (a bow turns every side
+    /// tag toward the floor; the top faces the camera then).
+    #[arg(long)]
+    pub box_top: Option<f64>,
+}
+
+impl BoxArgs {
+    /// The box these arguments describe.
+    pub fn size(&self) -> BoxSize {
+        BoxSize {
+            width: self.box_width,
+            depth: self.box_depth,
+            top: self.box_top,
+        }
+    }
 }
 
 /// The rig `--rig` names (`None`: one tag `id` on the chest), checked against the family.
@@ -121,7 +137,7 @@ pub fn rig_from_args(
             tag_pattern(family, id)?;
             Ok(Rig::single(id, tag_size))
         }
-        Some("box") => Rig::checked_box(family, id, tag_size, size.box_width, size.box_depth),
+        Some("box") => Rig::checked_box(family, id, tag_size, size.size()),
         Some(path) => Rig::read(Path::new(path), family, tag_size),
     }
 }
@@ -303,10 +319,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             Faults::default()
         },
         seed: a.seed,
-        rig_box: a.rig.as_ref().map(|_| BoxSize {
-            width: a.box_size.box_width,
-            depth: a.box_size.box_depth,
-        }),
+        rig_box: a.rig.as_ref().map(|_| a.box_size.size()),
         ..Setup::default()
     };
     let placed = if a.as_is {

@@ -175,7 +175,7 @@ pub fn tags_in_sight(scene: &Scene, pose: &PoseSample) -> usize {
 /// The rig of `setup`: its box, or tag `id` alone on the chest.
 pub fn rig(setup: &Setup, family: Family, id: u32) -> Result<Rig, TrackError> {
     match setup.rig_box {
-        Some(b) => Rig::checked_box(family, id, setup.tag_size, b.width, b.depth),
+        Some(b) => Rig::checked_box(family, id, setup.tag_size, b),
         None => {
             tag_pattern(family, id)?;
             Ok(Rig::single(id, setup.tag_size))

@@ -468,6 +468,44 @@ mod tests {
         assert!(angle_between_deg(got_q, q) < 2.0);
     }
 
+    #[test]
+    fn a_deep_bow_is_followed_by_the_box_s_top_tag() {
+        use crate::track::body::Body;
+        use crate::track::detect::tag_pattern;
+        use crate::track::pose::angle_between_deg;
+        use crate::track::rig::BoxSize;
+        let size = BoxSize {
+            top: Some(0.09),
+            ..BoxSize::sides(0.08, 0.08)
+        };
+        let rig = Rig::checked_box(Family::Tag36h11, 0, 0.04, size).unwrap();
+        let patterns = (0..5)
+            .map(|id| tag_pattern(Family::Tag36h11, id).unwrap())
+            .collect();
+        let s = Scene {
+            body: Body::rig_box(&rig, patterns, 0.08, 0.08),
+            ..scene()
+        };
+        let d = Detector::new(Family::Tag36h11, DetectorSettings::default()).unwrap();
+        let mut tr = Tracker::with_rig(d, rig, s.intrinsics);
+        // Bowed 75° toward the camera, 0.8 m away: the front tag is a sliver, the top square on.
+        let q = DQuat::from_rotation_x(75f64.to_radians());
+        let truth = PoseSample {
+            t: 0.0,
+            pos: [0.0, 0.0, -0.8],
+            quat: [q.w, q.x, q.y, q.z],
+        };
+        let frame = s.render(&s.background(), 0, 0.0, |_| Some(truth)).frame;
+        let r = tr.frame(0.0, &frame);
+        let ids: Vec<u32> = r.detections.iter().map(|d| d.id).collect();
+        assert_eq!(ids, [4], "only the top tag");
+        let got = r.sample.expect("a sample");
+        let err = (glam::DVec3::from_array(got.pos) - glam::DVec3::from_array(truth.pos)).length();
+        assert!(err < 6e-3, "{:.1} mm off", err * 1000.0);
+        let got_q = DQuat::from_xyzw(got.quat[1], got.quat[2], got.quat[3], got.quat[0]);
+        assert!(angle_between_deg(got_q, q) < 4.0);
+    }
+
     /// Speeding up across the view 0.45 m away: 0.5 m/s at first, 1.35 m/s after 0.33 s
     /// (a smear of 8–13 px over the 8 ms exposure on a tag 50 px wide).
     fn dash(t: f64) -> PoseSample {
