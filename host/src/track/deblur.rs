@@ -136,7 +136,7 @@ mod tests {
     fn bars(w: usize, h: usize, period: usize) -> Vec<f32> {
         (0..w * h)
             .map(|i| {
-                if (i % w / period) % 2 == 0 {
+                if (i % w / period).is_multiple_of(2) {
                     40.0
                 } else {
                     210.0

@@ -314,7 +314,7 @@ impl Tracker {
         }
         let blur = seen.velocity.map(|v| v * self.exposure_s);
         let len = blur[0].hypot(blur[1]);
-        if !(len >= MIN_BLUR_PX) {
+        if len.is_nan() || len < MIN_BLUR_PX {
             return None;
         }
         let (vx, vy) = (seen.velocity[0] * dt, seen.velocity[1] * dt);
