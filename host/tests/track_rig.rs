@@ -45,13 +45,7 @@ fn longest_gap(frames: &[figurine_host::track::eval::FrameError]) -> usize {
 fn a_box_rig_is_tracked_at_every_heading_of_a_full_turn() {
     let dir = scratch("rig-spin");
     let mut lost = Vec::new();
-    for rig_box in [
-        Some(BoxSize {
-            width: 0.08,
-            depth: 0.08,
-        }),
-        None,
-    ] {
+    for rig_box in [Some(BoxSize::sides(0.08, 0.08)), None] {
         let setup = Setup {
             seed: 3,
             rig_box,
@@ -141,10 +135,7 @@ fn a_fast_turn_stays_within_half_the_mirror_angle_at_every_frame() {
     let dir = scratch("rig-mirror");
     let setup = Setup {
         seed: 5,
-        rig_box: Some(BoxSize {
-            width: 0.08,
-            depth: 0.08,
-        }),
+        rig_box: Some(BoxSize::sides(0.08, 0.08)),
         faults: Faults {
             occlusion_every_s: 0.0,
             ..Faults::default()

@@ -13,9 +13,10 @@ use clap::Args;
 
 use super::detect::Family;
 use super::eval::{
-    compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
-    FrameError, FrameTruth, Noise, Setup, Summary, Tracking,
+    compare, place, quantile, render_video, scene, still_noise, summarize, tags_in_sight,
+    track_video, truth_log, FrameError, FrameTruth, Noise, Setup, Summary, Tracking,
 };
+use super::render::Scene;
 use super::rig::{BoxSize, DEFAULT_BOX_M};
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
@@ -45,6 +46,10 @@ pub struct BenchArgs {
     /// comparing the two).
     #[arg(long)]
     pub whole_frames: bool,
+    /// The camera exposure the tracker assumes for its motion-blur retry, milliseconds (the
+    /// videos are rendered with 8 ms whatever this says; 0 turns the retry off).
+    #[arg(long, default_value_t = super::tracker::DEFAULT_EXPOSURE_S * 1000.0)]
+    pub exposure_ms: f64,
     /// Track a rig of four tags around the figurine instead of one on its chest: `box`, a
     /// box with tags 0, 1, 2, 3 on its front, left, back and right sides.
     #[arg(long, value_parser = ["box"])]
@@ -55,6 +60,10 @@ pub struct BenchArgs {
     /// The box rig's depth (front to back, its Z), metres.
     #[arg(long, default_value_t = DEFAULT_BOX_M)]
     pub box_depth: f64,
+    /// With `--rig box`: a fifth tag on the box's top, this high above the side tags' centres
+    /// (metres; the box is drawn that tall).
+    #[arg(long, requires = "rig")]
+    pub box_top: Option<f64>,
     /// With `--keep DIR`: track the videos an earlier run kept there (same seed, distances
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
@@ -112,7 +121,7 @@ pub fn run_gesture(
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
     let frames_path = video.with_extension("frames.csv");
     let kept = if reuse && video.exists() {
-        read_truths(&frames_path, setup).ok()
+        read_truths(&frames_path, setup, &sc).ok()
     } else {
         None
     };
@@ -193,8 +202,9 @@ fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) ->
 }
 
 /// Reads what [`write_truths`] wrote; an error when it is missing, malformed or was written
-/// for another setup.
-fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>> {
+/// for another setup. A frame whose tags were all outside the picture is out of sight even if
+/// the file (written before that counted) says otherwise.
+fn read_truths(path: &std::path::Path, setup: &Setup, scene: &Scene) -> Result<Vec<FrameTruth>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut lines = text.lines();
@@ -209,15 +219,16 @@ fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>>
                 .collect::<Result<_, _>>()
                 .with_context(|| format!("{}: {line}", path.display()))?;
             anyhow::ensure!(v.len() == 11, "{}: {line}", path.display());
+            let pose = crate::poselog::PoseSample {
+                t: v[10],
+                pos: [v[1], v[2], v[3]],
+                quat: [v[4], v[5], v[6], v[7]],
+            };
             Ok(FrameTruth {
                 t: v[0],
-                pose: crate::poselog::PoseSample {
-                    t: v[10],
-                    pos: [v[1], v[2], v[3]],
-                    quat: [v[4], v[5], v[6], v[7]],
-                },
+                pose,
                 speed: v[8],
-                hidden: v[9] != 0.0,
+                hidden: v[9] != 0.0 || tags_in_sight(scene, &pose) == 0,
             })
         })
         .collect()
@@ -226,7 +237,10 @@ fn read_truths(path: &std::path::Path, setup: &Setup) -> Result<Vec<FrameTruth>>
 /// The first line of a kept video's truths: the setup it was drawn with.
 fn truths_head(setup: &Setup) -> String {
     let rig = setup.rig_box.map_or(String::new(), |b| {
-        format!(", box {} × {} m", b.width, b.depth)
+        let top = b
+            .top
+            .map_or(String::new(), |h| format!(", top tag {h} m up"));
+        format!(", box {} × {} m{top}", b.width, b.depth)
     });
     format!(
         "# tag {} m at {} m, seed {}{rig}",
@@ -381,10 +395,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let rig_box = args.rig.as_ref().map(|_| BoxSize {
         width: args.box_width,
         depth: args.box_depth,
+        top: args.box_top,
     });
     if let Some(b) = rig_box {
-        let rig =
-            super::rig::Rig::checked_box(Family::Tag36h11, 0, args.tag_size, b.width, b.depth)?;
+        let rig = super::rig::Rig::checked_box(Family::Tag36h11, 0, args.tag_size, b)?;
         eprintln!("a box rig of {} × {} m:", b.width, b.depth);
         for line in rig.describe() {
             eprintln!("  {line}");
@@ -405,6 +419,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let how = Tracking {
                 smooth: !args.raw,
                 region_search: !args.whole_frames,
+                exposure_s: args.exposure_ms.max(0.0) / 1000.0,
             };
             let r = run_gesture(&setup, action, seed, &dir, how, args.reuse)?;
             let s = summarize(&r.frames);
@@ -478,12 +493,24 @@ mod tests {
             hidden: true,
         }];
         write_truths(&path, &setup, &truths).unwrap();
-        assert_eq!(read_truths(&path, &setup).unwrap(), truths);
+        let sc = scene(&setup, Family::Tag36h11, 0).unwrap();
+        assert_eq!(read_truths(&path, &setup, &sc).unwrap(), truths);
+        // Written as in sight but the tag is off the picture's left edge: out of sight.
+        let off = FrameTruth {
+            hidden: false,
+            pose: crate::poselog::PoseSample {
+                pos: [-0.45, 0.0, -0.7],
+                ..truths[0].pose
+            },
+            ..truths[0]
+        };
+        write_truths(&path, &setup, &[off]).unwrap();
+        assert!(read_truths(&path, &setup, &sc).unwrap()[0].hidden);
         let other = Setup {
             distance: 1.0,
             ..setup
         };
-        assert!(read_truths(&path, &other).is_err());
+        assert!(read_truths(&path, &other, &sc).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -78,16 +78,32 @@ impl Body {
 
     /// A box `width` × `depth` metres around the figurine's origin with the rig's tags on its
     /// sides (`patterns` in the rig's face order), as tall as the chest's torso, closed by
-    /// a plain top and bottom.
+    /// a plain bottom and a top — the rig's top tag on it if the rig has one (its height then
+    /// sets the box's top), plain otherwise.
     pub fn rig_box(rig: &Rig, patterns: Vec<TagPattern>, width: f64, depth: f64) -> Self {
         let half_card = patterns.first().map_or(0.0, |p| half_card(p, rig.tag_size));
-        let (top, bottom) = (half_card + ABOVE_CARD, half_card + BELOW_CARD);
+        let is_top = |f: &super::rig::Face| (f.rotation * DVec3::Z).y > 0.5;
+        let top_face = rig.faces.iter().find(|f| is_top(f));
+        let top = top_face.map_or(half_card + ABOVE_CARD, |f| f.centre.y);
+        let bottom = half_card + BELOW_CARD;
         let mut panels: Vec<Panel> = rig
             .faces
             .iter()
             .zip(patterns)
             .map(|(f, tag)| {
                 let normal = f.rotation * DVec3::Z;
+                if is_top(f) {
+                    // u along the figurine's X, v (down as seen) toward its front.
+                    return Panel {
+                        rotation: f.rotation,
+                        centre: f.centre,
+                        half_width: width / 2.0,
+                        top: depth / 2.0,
+                        bottom: depth / 2.0,
+                        tag: Some(tag),
+                        two_sided: false,
+                    };
+                }
                 let across = if normal.z.abs() > normal.x.abs() {
                     width
                 } else {
@@ -104,8 +120,12 @@ impl Body {
                 }
             })
             .collect();
-        // Top and bottom: u along the figurine's X, v along its depth.
-        for (normal, y) in [(DVec3::Y, -top), (DVec3::NEG_Y, bottom)] {
+        // Plain caps: u along the figurine's X, v along its depth.
+        let caps = match top_face {
+            None => vec![(DVec3::Y, -top), (DVec3::NEG_Y, bottom)],
+            Some(_) => vec![(DVec3::NEG_Y, bottom)],
+        };
+        for (normal, y) in caps {
             panels.push(Panel {
                 rotation: DQuat::from_rotation_arc(DVec3::Z, normal),
                 centre: DVec3::new(0.0, -y, 0.0),
@@ -209,5 +229,30 @@ mod tests {
         assert_eq!(body.shade(front, border, 0.0, true), Some(INK));
         assert_eq!(body.shade(front, 0.038, 0.0, true), Some(BODY));
         assert_eq!(body.shade(front, 0.05, 0.0, true), None);
+    }
+
+    #[test]
+    fn a_top_tag_replaces_the_plain_top_at_its_height() {
+        let mut rig = Rig::boxed(0, 0.04, 0.08, 0.06);
+        rig.faces.push(Rig::top_face(4, 0.1));
+        let patterns = (0..5)
+            .map(|id| tag_pattern(Family::Tag36h11, id).unwrap())
+            .collect();
+        let body = Body::rig_box(&rig, patterns, 0.08, 0.06);
+        // Four sides, the top with its tag, the plain bottom.
+        assert_eq!(body.panels.len(), 6);
+        let top = &body.panels[4];
+        assert!(top.tag.is_some() && (top.centre.y - 0.1).abs() < 1e-12);
+        assert!(
+            (body.panels[0].top - 0.1).abs() < 1e-12,
+            "the sides reach the top"
+        );
+        // The top spans the box: its v (down as seen from above, the back far) runs front to
+        // back over the depth, its u across the width.
+        let corner = top.centre + top.rotation * DVec3::new(top.half_width, top.bottom, 0.0);
+        let front_edge = body.panels[0].centre.z;
+        assert!((corner.z.abs() - front_edge).abs() < 1e-12, "{corner}");
+        assert!((corner.x.abs() - 0.04).abs() < 1e-12, "{corner}");
+        assert!(body.panels[5].tag.is_none() && body.panels[5].centre.y < 0.0);
     }
 }

@@ -21,7 +21,7 @@ use super::pose::{camera_pose, intrinsics_from_fov, project, Calibration, DEFAUL
 use super::print::print_tags;
 use super::render::Faults;
 use super::rig::{BoxSize, Rig, DEFAULT_BOX_M};
-use super::tracker::Tracker;
+use super::tracker::{Tracker, DEFAULT_EXPOSURE_S};
 use super::video::{FrameReader, Source};
 use super::TrackError;
 use crate::poselog::{PoseLog, PoseSample, HEADER};
@@ -82,6 +82,10 @@ pub struct RunArgs {
     /// figurine from jittering by a degree or two.
     #[arg(long)]
     pub raw: bool,
+    /// The camera's exposure time, milliseconds, from which a fast tag's motion blur is
+    /// predicted and undone when the plain search misses it (0: never).
+    #[arg(long, default_value_t = DEFAULT_EXPOSURE_S * 1000.0)]
+    pub exposure_ms: f64,
     /// Track a rig of tags around the figurine instead of one on its chest: `box` (tags
     /// `--tag-id` … `--tag-id`+3 on the front, left, back and right sides of a box, see
     /// `--box-width`, `--box-depth`) or a rig file (JSON: each tag's id, centre, normal and up
@@ -102,6 +106,22 @@ pub struct BoxArgs {
     /// The box rig's depth (front to back, its Z: its left and right faces), metres.
     #[arg(long, default_value_t = DEFAULT_BOX_M)]
     pub box_depth: f64,
+    /// A fifth tag (`--tag-id`+4) on the box's top, its printed top toward the figurine's
+    /// back: the top's height above the side tags' centres, metres (a bow turns every side
+    /// tag toward the floor; the top faces the camera then).
+    #[arg(long)]
+    pub box_top: Option<f64>,
+}
+
+impl BoxArgs {
+    /// The box these arguments describe.
+    pub fn size(&self) -> BoxSize {
+        BoxSize {
+            width: self.box_width,
+            depth: self.box_depth,
+            top: self.box_top,
+        }
+    }
 }
 
 /// The rig `--rig` names (`None`: one tag `id` on the chest), checked against the family.
@@ -117,7 +137,7 @@ pub fn rig_from_args(
             tag_pattern(family, id)?;
             Ok(Rig::single(id, tag_size))
         }
-        Some("box") => Rig::checked_box(family, id, tag_size, size.box_width, size.box_depth),
+        Some("box") => Rig::checked_box(family, id, tag_size, size.size()),
         Some(path) => Rig::read(Path::new(path), family, tag_size),
     }
 }
@@ -299,10 +319,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             Faults::default()
         },
         seed: a.seed,
-        rig_box: a.rig.as_ref().map(|_| BoxSize {
-            width: a.box_size.box_width,
-            depth: a.box_size.box_depth,
-        }),
+        rig_box: a.rig.as_ref().map(|_| a.box_size.size()),
         ..Setup::default()
     };
     let placed = if a.as_is {
@@ -397,6 +414,13 @@ pub fn track(args: &RunArgs) -> Result<()> {
         }
     };
     // Checked before any frame is read, so a bad file is reported as such at once.
+    if !(args.exposure_ms >= 0.0 && args.exposure_ms < 1000.0) {
+        return Err(TrackError::BadArgument(format!(
+            "--exposure-ms {}: the camera's exposure in milliseconds (0 to 1000)",
+            args.exposure_ms
+        ))
+        .into());
+    }
     if let Some(path) = &args.calibration {
         Calibration::read(path)?;
     }
@@ -418,7 +442,9 @@ pub fn track(args: &RunArgs) -> Result<()> {
         }
     }
     let tag_size = rig.tag_size;
-    let mut tracker = Tracker::with_rig(detector, rig, k).with_smoothing(!args.raw);
+    let mut tracker = Tracker::with_rig(detector, rig, k)
+        .with_smoothing(!args.raw)
+        .with_exposure(args.exposure_ms / 1000.0);
     let mut sink = Sink::open(args.out.as_deref())?;
     let mut overlay_done = args.overlay.is_none();
     let mut frames = 0u64;

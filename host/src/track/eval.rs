@@ -10,7 +10,7 @@ use glam::{DQuat, DVec3};
 
 use super::body::Body;
 use super::detect::{tag_pattern, Detector, DetectorSettings, Family};
-use super::pose::{angle_between_deg, intrinsics_from_fov};
+use super::pose::{angle_between_deg, intrinsics_from_fov, project, FLIP_YZ};
 use super::render::{Faults, Scene};
 use super::rig::{BoxSize, Rig};
 use super::tracker::{track_reader, Tracker};
@@ -129,9 +129,9 @@ pub struct FrameTruth {
     pub pose: PoseSample,
     /// The figurine's speed, m/s.
     pub speed: f64,
-    /// Whether every tag was out of sight: a finger covered part of it, or it was turned more
+    /// Whether every tag was out of sight: a finger covered part of it, it was turned more
     /// than [`MAX_VIEW_DEG`] from the camera (for one tag on the chest, the back of a turn or
-    /// spin).
+    /// spin), or part of it was outside the picture.
     pub hidden: bool,
 }
 
@@ -146,9 +146,18 @@ pub fn facing_deg(pose: &PoseSample) -> f64 {
     front.angle_between(to_camera).to_degrees()
 }
 
-/// How many of the body's tags face the camera within [`MAX_VIEW_DEG`] at `pose`.
-pub fn tags_in_sight(body: &Body, pose: &PoseSample) -> usize {
+/// How many of the body's tags are in sight at `pose`: facing the camera within
+/// [`MAX_VIEW_DEG`], and whole inside the picture (a tag cut by the frame's edge cannot be
+/// read, however well it faces the camera).
+pub fn tags_in_sight(scene: &Scene, pose: &PoseSample) -> usize {
     let (pos, q) = (DVec3::from_array(pose.pos), quat(pose));
+    let body = &scene.body;
+    let half = body.tag_size / 2.0;
+    let inside = |p: DVec3| {
+        project(&scene.intrinsics, FLIP_YZ * p).is_some_and(|[x, y]| {
+            x >= 0.0 && y >= 0.0 && x <= scene.width as f64 && y <= scene.height as f64
+        })
+    };
     body.panels
         .iter()
         .filter(|p| p.tag.is_some())
@@ -156,6 +165,9 @@ pub fn tags_in_sight(body: &Body, pose: &PoseSample) -> usize {
             let (centre, pq) = body.panel_pose(p, pos, q);
             let angle = (pq * DVec3::Z).angle_between(-centre).to_degrees();
             angle <= MAX_VIEW_DEG
+                && [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                    .iter()
+                    .all(|&(u, v)| inside(centre + pq * DVec3::new(u * half, v * half, 0.0)))
         })
         .count()
 }
@@ -163,7 +175,7 @@ pub fn tags_in_sight(body: &Body, pose: &PoseSample) -> usize {
 /// The rig of `setup`: its box, or tag `id` alone on the chest.
 pub fn rig(setup: &Setup, family: Family, id: u32) -> Result<Rig, TrackError> {
     match setup.rig_box {
-        Some(b) => Rig::checked_box(family, id, setup.tag_size, b.width, b.depth),
+        Some(b) => Rig::checked_box(family, id, setup.tag_size, b),
         None => {
             tag_pattern(family, id)?;
             Ok(Rig::single(id, setup.tag_size))
@@ -229,7 +241,7 @@ pub fn render_video(
             t: tv,
             pose,
             speed: if speed.is_finite() { speed } else { 0.0 },
-            hidden: tags_in_sight(&scene.body, &pose) <= usize::from(r.occluded),
+            hidden: tags_in_sight(scene, &pose) <= usize::from(r.occluded),
         });
     }
     out.finish()?;
@@ -237,12 +249,15 @@ pub fn render_video(
 }
 
 /// The tracker's switches a test run sets (those of `figurine track`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tracking {
     /// Smooth the orientation ([`super::smooth`]; `figurine track --raw` turns it off).
     pub smooth: bool,
     /// Search near the tag's last place first ([`Tracker::with_region_search`]).
     pub region_search: bool,
+    /// The exposure the tracker assumes, seconds ([`Tracker::with_exposure`]): its guess, not
+    /// necessarily the exposure the video was rendered with.
+    pub exposure_s: f64,
 }
 
 impl Default for Tracking {
@@ -250,6 +265,7 @@ impl Default for Tracking {
         Self {
             smooth: true,
             region_search: true,
+            exposure_s: super::tracker::DEFAULT_EXPOSURE_S,
         }
     }
 }
@@ -267,7 +283,8 @@ pub fn track_video(
     let detector = Detector::new(family, DetectorSettings::default())?;
     let mut tracker = Tracker::with_rig(detector, rig(setup, family, id)?, k)
         .with_smoothing(how.smooth)
-        .with_region_search(how.region_search);
+        .with_region_search(how.region_search)
+        .with_exposure(how.exposure_s);
     track_reader(&mut reader, &mut tracker, |_| Ok(()))
 }
 
@@ -482,6 +499,25 @@ mod tests {
         // The path keeps its shape: consecutive steps are still 1 m long.
         let step = DVec3::from_array(placed.samples[1].pos) - DVec3::from_array(first.pos);
         assert!((step.length() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_tag_is_in_sight_facing_the_camera_and_whole_inside_the_picture() {
+        let sc = scene(&Setup::default(), Family::Tag36h11, 0).unwrap();
+        let at = |x: f64, yaw_deg: f64| {
+            let q = DQuat::from_rotation_y(yaw_deg.to_radians());
+            PoseSample {
+                t: 0.0,
+                pos: [x, 0.0, -0.7],
+                quat: [q.w, q.x, q.y, q.z],
+            }
+        };
+        assert_eq!(tags_in_sight(&sc, &at(0.0, 0.0)), 1);
+        assert_eq!(tags_in_sight(&sc, &at(0.0, 60.0)), 1);
+        assert_eq!(tags_in_sight(&sc, &at(0.0, 80.0)), 0, "turned away");
+        // The frame's edge is 0.404 m off-centre at 0.7 m: the tag's half (2 cm) crosses it.
+        assert_eq!(tags_in_sight(&sc, &at(0.37, 0.0)), 1);
+        assert_eq!(tags_in_sight(&sc, &at(0.395, 0.0)), 0, "cut by the edge");
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod bench;
 pub mod body;
 pub mod calibrate;
 pub mod cli;
+pub mod deblur;
 pub mod detect;
 pub mod eval;
 pub mod fuse;

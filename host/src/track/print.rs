@@ -9,7 +9,7 @@ use std::path::Path;
 use image::{Rgb, RgbImage};
 
 use super::detect::{tag_pattern, Family, TagPattern};
-use super::rig::Rig;
+use super::rig::{Face, Rig};
 use super::TrackError;
 use crate::raster::{draw_text, text_width};
 
@@ -35,15 +35,25 @@ pub fn caption(family: Family, id: u32, size_m: f64) -> [String; 2] {
     ]
 }
 
-/// The caption of a rig's tag: as [`caption`], and the face it goes on.
-pub fn rig_caption(family: Family, id: u32, size_m: f64, face: &str) -> [String; 2] {
+/// The caption of a rig's tag: as [`caption`], the face it goes on, and which way its
+/// printed top points on the figurine (up on the sides; toward the back on a box's top).
+pub fn rig_caption(family: Family, id: u32, size_m: f64, face: &Face) -> [String; 2] {
     let [first, _] = caption(family, id, size_m);
+    let up = face.rotation * glam::DVec3::Y;
+    let way = [
+        (glam::DVec3::Y, "THIS WAY UP"),
+        (glam::DVec3::NEG_Y, "THIS EDGE DOWN"),
+        (glam::DVec3::Z, "THIS EDGE TO ITS FRONT"),
+        (glam::DVec3::NEG_Z, "THIS EDGE TO ITS BACK"),
+        (glam::DVec3::X, "THIS EDGE TO ITS LEFT"),
+        (glam::DVec3::NEG_X, "THIS EDGE TO ITS RIGHT"),
+    ]
+    .into_iter()
+    .max_by(|a, b| up.dot(a.0).total_cmp(&up.dot(b.0)))
+    .map_or("THIS WAY UP", |(_, w)| w);
     [
         first,
-        format!(
-            "ON THE {} OF THE FIGURINE, THIS WAY UP",
-            face.to_uppercase()
-        ),
+        format!("ON THE {} OF THE FIGURINE, {way}", face.name.to_uppercase()),
     ]
 }
 
@@ -252,7 +262,7 @@ pub fn print_tags(
             .map(|f| {
                 Ok((
                     tag_pattern(family, f.id)?,
-                    rig_caption(family, f.id, rig.tag_size, &f.name),
+                    rig_caption(family, f.id, rig.tag_size, f),
                 ))
             })
             .collect::<Result<_, TrackError>>()?,
@@ -283,6 +293,26 @@ pub fn print_tags(
 mod tests {
     use super::*;
     use crate::track::detect::{tag_pattern, Detector, DetectorSettings, GrayFrame};
+
+    #[test]
+    fn a_rig_caption_says_which_way_each_tag_goes() {
+        let size = crate::track::rig::BoxSize {
+            top: Some(0.09),
+            ..crate::track::rig::BoxSize::sides(0.08, 0.08)
+        };
+        let rig = Rig::checked_box(Family::Tag36h11, 0, 0.04, size).unwrap();
+        let lines: Vec<String> = rig
+            .faces
+            .iter()
+            .map(|f| rig_caption(Family::Tag36h11, f.id, 0.04, f)[1].clone())
+            .collect();
+        assert_eq!(lines[0], "ON THE FRONT OF THE FIGURINE, THIS WAY UP");
+        assert_eq!(lines[3], "ON THE RIGHT OF THE FIGURINE, THIS WAY UP");
+        assert_eq!(
+            lines[4],
+            "ON THE TOP OF THE FIGURINE, THIS EDGE TO ITS BACK"
+        );
+    }
 
     #[test]
     fn the_printed_png_is_detected_and_says_its_size() {

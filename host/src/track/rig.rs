@@ -15,7 +15,10 @@
 //! on its face: **first id on the front** (+Z), **+1 on the left** (+X), **+2 on the back**
 //! (−Z), **+3 on the right** (−X), in the order a figurine turning to its right shows them
 //! to the camera.
-//! The figurine's origin is the box's centre.
+//! The figurine's origin is the box's centre. With a top (`--box-top H`, the top's height in
+//! metres above the side tags' centres) **+4 lies on the top**, facing up, its printed top
+//! toward the figurine's back: a figurine bowing to the camera shows it upright, when every
+//! side tag has tilted toward the floor.
 
 use std::path::Path;
 
@@ -46,6 +49,20 @@ pub struct BoxSize {
     pub width: f64,
     /// Front to back, along its Z (the left and right faces' width).
     pub depth: f64,
+    /// With a tag on its top: the top's height above the side tags' centres (the figurine's
+    /// origin), metres; `None`: the sides only.
+    pub top: Option<f64>,
+}
+
+impl BoxSize {
+    /// A box with tags on its four sides only.
+    pub fn sides(width: f64, depth: f64) -> Self {
+        Self {
+            width,
+            depth,
+            top: None,
+        }
+    }
 }
 
 /// One tag of the rig and where it sits on the figurine.
@@ -163,16 +180,39 @@ impl Rig {
         Self { tag_size, faces }
     }
 
+    /// The box's top face: tag `id` centred on it `height` metres above the figurine's
+    /// origin, facing up, its printed top toward the figurine's back (−Z) so that it reads
+    /// upright to a camera the figurine bows to.
+    pub fn top_face(id: u32, height: f64) -> Face {
+        let (normal, up) = (DVec3::Y, DVec3::NEG_Z);
+        Face {
+            id,
+            name: "top".into(),
+            centre: normal * height,
+            rotation: DQuat::from_mat3(&DMat3::from_cols(up.cross(normal), up, normal)).normalize(),
+        }
+    }
+
     /// A box checked against the tags it carries: every id in `family`, the tag's card
-    /// (the black square and a white margin) narrower than the face.
+    /// (the black square and a white margin) narrower than the face; with a top, its tag
+    /// (id `first_id` + 4) above the side tags' cards.
     pub fn checked_box(
         family: Family,
         first_id: u32,
         tag_size: f64,
-        width: f64,
-        depth: f64,
+        size: BoxSize,
     ) -> Result<Self, TrackError> {
+        let BoxSize { width, depth, top } = size;
         let card = tag_size * 1.25;
+        if let Some(h) = top {
+            if !(h.is_finite() && h >= card / 2.0 && h < 1.0) {
+                return Err(TrackError::BadRig(format!(
+                    "box top {h} m: the top must be above the side tags' cards ({:.0} mm or \
+                     more above their centres, metres under 1)",
+                    card / 2.0 * 1000.0
+                )));
+            }
+        }
         for (what, v) in [("width", width), ("depth", depth)] {
             if !(v.is_finite() && v >= card && v < 2.0) {
                 return Err(TrackError::BadRig(format!(
@@ -183,7 +223,11 @@ impl Rig {
                 )));
             }
         }
-        let rig = Self::boxed(first_id, tag_size, width, depth);
+        let mut rig = Self::boxed(first_id, tag_size, width, depth);
+        if let Some(h) = top {
+            rig.faces
+                .push(Self::top_face(first_id + BOX_FACES.len() as u32, h));
+        }
         rig.check(family)?;
         Ok(rig)
     }
@@ -309,7 +353,8 @@ mod tests {
 
     #[test]
     fn every_face_gives_the_same_figurine_pose() {
-        let rig = Rig::boxed(4, 0.04, 0.08, 0.06);
+        let mut rig = Rig::boxed(4, 0.04, 0.08, 0.06);
+        rig.faces.push(Rig::top_face(8, 0.09));
         let p = DVec3::new(0.05, -0.02, -0.7);
         for yaw in [0.0, 0.8, 2.0, -2.5] {
             let q = DQuat::from_euler(glam::EulerRot::YXZ, yaw, 0.2, -0.1);
@@ -342,6 +387,24 @@ mod tests {
         // The front tag's corners sit 3 cm ahead of the origin (body frame z is −front).
         let c = rig.faces[0].corners_in_body(0.04);
         assert!(c.iter().all(|p| (p.z + 0.03).abs() < 1e-12));
+        // The top tag faces up, its printed top toward the back, its right edge (as seen from
+        // above, the back far) toward the figurine's left.
+        let top = Rig::checked_box(
+            Family::Tag36h11,
+            0,
+            0.04,
+            BoxSize {
+                top: Some(0.09),
+                ..BoxSize::sides(0.08, 0.06)
+            },
+        )
+        .unwrap();
+        let t = top.face(4).unwrap();
+        assert_eq!(t.name, "top");
+        assert!((t.rotation * DVec3::Z - DVec3::Y).length() < 1e-12);
+        assert!((t.rotation * DVec3::Y - DVec3::NEG_Z).length() < 1e-12);
+        assert!((t.rotation * DVec3::X - DVec3::X).length() < 1e-12);
+        assert!((t.centre - DVec3::new(0.0, 0.09, 0.0)).length() < 1e-12);
         // A one-face rig is the chest tag: its body is its tag.
         let one = Rig::single(7, 0.04);
         assert_eq!(one.faces[0].corners_in_body(0.04), object_corners(0.04));
@@ -398,9 +461,17 @@ mod tests {
                 .to_string();
             assert!(e.contains(why), "`{why}` not in: {e}");
         }
-        let e = Rig::checked_box(Family::Tag36h11, 0, 0.04, 0.03, 0.08).unwrap_err();
+        let e =
+            Rig::checked_box(Family::Tag36h11, 0, 0.04, BoxSize::sides(0.03, 0.08)).unwrap_err();
         assert!(e.to_string().contains("box width 0.03 m"), "{e}");
-        assert!(Rig::checked_box(Family::Tag36h11, 585, 0.04, 0.08, 0.08).is_err());
+        let sides = BoxSize::sides(0.08, 0.08);
+        assert!(Rig::checked_box(Family::Tag36h11, 585, 0.04, sides).is_err());
+        let low = BoxSize {
+            top: Some(0.01),
+            ..sides
+        };
+        let e = Rig::checked_box(Family::Tag36h11, 0, 0.04, low).unwrap_err();
+        assert!(e.to_string().contains("box top 0.01 m"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
