@@ -20,6 +20,12 @@
 //!   millimetres) has not crouched; nothing is reported.
 //! - otherwise, a new event.
 //!
+//! Past [`CONTINUE_US`] the event stays held only as long as its action's examples held still
+//! inside ([`Library::hold_us`]: a crouch held low, then risen from), and only its rest may
+//! then follow it: another action's match over which the held action's pattern costs no more
+//! than the two apart, and which alone is not the held action again — a repetition after a
+//! hold is a new event.
+//!
 //! Motion is measured as path length plus [`ARM_M`] × the angle turned, so that a wave or a
 //! turn (much rotation, little path) is not mistaken for a settling. Everything here runs at
 //! commits only, never per sample.
