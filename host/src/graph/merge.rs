@@ -36,8 +36,10 @@ pub struct MergeStats {
     pub pairs: u64,
     /// Local minima the tiles found.
     pub local_minima: usize,
-    /// Seconds reading and checking tiles.
+    /// Seconds reading and checking tiles, and reading the measurements from the store.
     pub read_seconds: f64,
+    /// Bytes read from the feature store for the measurements.
+    pub store_bytes_read: u64,
     /// Seconds assembling the graph (style similarity of the survivors).
     pub assemble_seconds: f64,
 }
@@ -92,7 +94,8 @@ pub fn merge_job(job: &Path) -> Result<(MotionGraph, MergeStats), GraphError> {
     }
     // Tiles are disjoint and each sorted; one sort makes the order independent of tile order.
     let found = found.sorted();
-    let measurements = store.measurements(m.windows)?;
+    let (measurements, store_bytes_read) = store.measurements(m.windows)?;
+    stats.store_bytes_read = store_bytes_read;
     stats.read_seconds = t0.elapsed().as_secs_f64();
     stats.pairs = found.pairs;
     stats.local_minima = minima as usize;

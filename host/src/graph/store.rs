@@ -40,6 +40,7 @@ use arrow_ipc::writer::FileWriter;
 use arrow_schema::{DataType, Field, Schema};
 use glam::Vec3;
 
+use super::ipc_floats::TrailingFloatRows;
 use super::ipc_prefix::LeadingColumns;
 use super::lma::MEASUREMENTS;
 use super::posture::WindowTerms;
@@ -54,6 +55,8 @@ pub const STORE_VERSION: u32 = 1;
 const SEARCH_BUFFERS: usize = 11;
 /// IPC buffers of a whole record batch: those and the `lma` column's 3.
 const ALL_BUFFERS: usize = 14;
+/// Field nodes of a whole record batch: one per column, and one for each list's items.
+const ALL_NODES: usize = 8;
 /// Rows per record batch (the last batch of a file may be shorter).
 pub const BATCH_ROWS: usize = 65_536;
 /// Floats per frame in the `points` column (16 role points × x y z).
@@ -211,7 +214,7 @@ impl Store {
             path: path.to_path_buf(),
             frames,
         };
-        let r = s.reader(None)?;
+        let r = s.reader()?;
         let found_schema = r.schema();
         let meta = found_schema.metadata();
         if meta.get(KEY_FORMAT).map(String::as_str) != Some(FORMAT) {
@@ -250,27 +253,10 @@ impl Store {
         Ok(s)
     }
 
-    fn reader(
-        &self,
-        projection: Option<Vec<usize>>,
-    ) -> Result<FileReader<std::io::BufReader<File>>, GraphError> {
+    /// arrow-ipc's reader of the file: it reads the footer (schema, batch list) at once.
+    fn reader(&self) -> Result<FileReader<std::io::BufReader<File>>, GraphError> {
         let file = File::open(&self.path).map_err(|e| io_err(&self.path, e))?;
-        FileReader::try_new_buffered(file, projection).map_err(|e| arrow_err(&self.path, e))
-    }
-
-    /// Record batch `k` with columns `projection`, checked to have the expected row count.
-    fn batch(
-        &self,
-        r: &mut FileReader<std::io::BufReader<File>>,
-        k: usize,
-    ) -> Result<RecordBatch, GraphError> {
-        r.set_index(k).map_err(|e| arrow_err(&self.path, e))?;
-        let b = r
-            .next()
-            .ok_or_else(|| arrow_err(&self.path, format!("record batch {k} missing")))?
-            .map_err(|e| arrow_err(&self.path, format!("record batch {k}: {e}")))?;
-        self.check_rows(&b, k)?;
-        Ok(b)
+        FileReader::try_new_buffered(file, None).map_err(|e| arrow_err(&self.path, e))
     }
 
     /// Checks that record batch `b`, number `k`, has the expected row count.
@@ -351,40 +337,46 @@ impl Store {
     }
 
     /// The raw LMA measurements of every window (`windows × 114`, global order), checked to be
-    /// `windows` rows.
-    pub fn measurements(&self, windows: usize) -> Result<Vec<f32>, GraphError> {
-        let mut r = self.reader(Some(vec![5]))?;
-        let mut out = Vec::with_capacity(windows * MEASUREMENTS);
+    /// `windows` rows, and the bytes read from the file for them.
+    ///
+    /// Only the `lma` column is read, and of it only the rows of window centres: 456 bytes per
+    /// window of the 664 per frame, straight into the returned vector ([`super::ipc_floats`]).
+    pub fn measurements(&self, windows: usize) -> Result<(Vec<f32>, u64), GraphError> {
+        if windows > self.frames {
+            return Err(arrow_err(
+                &self.path,
+                format!(
+                    "the plan's {windows} windows exceed its {} frames",
+                    self.frames
+                ),
+            ));
+        }
+        let mut r = TrailingFloatRows::open(&self.path, MEASUREMENTS, ALL_NODES, ALL_BUFFERS)?;
+        let mut out = Vec::new();
+        out.try_reserve_exact(windows * MEASUREMENTS)
+            .map_err(|e| arrow_err(&self.path, format!("{windows} windows: {e}")))?;
         for k in 0..self.frames.div_ceil(BATCH_ROWS) {
-            let b = self.batch(&mut r, k)?;
-            let lma = b
-                .column(0)
-                .as_fixed_size_list_opt()
-                .ok_or_else(|| arrow_err(&self.path, "bad `lma` column"))?;
-            let v = lma
-                .values()
-                .as_primitive_opt::<Float32Type>()
-                .ok_or_else(|| arrow_err(&self.path, "bad `lma` column"))?;
-            for i in 0..lma.len() {
-                if lma.is_valid(i) {
-                    let row = v
-                        .values()
-                        .get(lma.value_offset_at(i)..lma.value_offset_at(i + 1))
-                        .ok_or_else(|| arrow_err(&self.path, "short `lma` column"))?;
-                    out.extend_from_slice(row);
-                }
+            let rows = (self.frames - k * BATCH_ROWS).min(BATCH_ROWS);
+            r.append_batch(k, rows, &mut out)?;
+            if out.len() > windows * MEASUREMENTS {
+                break;
             }
         }
         if out.len() != windows * MEASUREMENTS {
             return Err(arrow_err(
                 &self.path,
                 format!(
-                    "{} windows, the plan has {windows}",
+                    "{}{} windows, the plan has {windows}",
+                    if out.len() > windows * MEASUREMENTS {
+                        "more than "
+                    } else {
+                        ""
+                    },
                     out.len() / MEASUREMENTS
                 ),
             ));
         }
-        Ok(out)
+        Ok((out, r.bytes_read()))
     }
 }
 
@@ -424,7 +416,12 @@ mod tests {
         assert_eq!(part.base, 20);
         assert_eq!(part.points, rows.points[20..77]);
         assert_eq!(part.terms, rows.terms[20..77]);
-        let back = s.measurements(meas.len() / MEASUREMENTS).unwrap();
+        let (back, read) = s.measurements(meas.len() / MEASUREMENTS).unwrap();
+        // The measurements' own bytes and little more (messages, a validity bitmap).
+        assert!(
+            read >= 4 * meas.len() as u64 && read < 4 * meas.len() as u64 + 1024,
+            "{read}"
+        );
         assert_eq!(
             back.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             meas.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
