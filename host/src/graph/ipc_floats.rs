@@ -142,8 +142,8 @@ impl TrailingFloatRows {
             (at.checked_add(len)? <= body_len).then_some((at, len))
         };
         let (Some((mask_at, mask_len)), Some((values_at, values_len))) = (
-            span(&buffers.get(self.all_buffers - 3)),
-            span(&buffers.get(self.all_buffers - 1)),
+            span(buffers.get(self.all_buffers - 3)),
+            span(buffers.get(self.all_buffers - 1)),
         ) else {
             return Err(bad(
                 "a buffer of its last column lies outside the batch".into()
