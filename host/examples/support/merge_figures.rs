@@ -8,6 +8,10 @@
 //! the bytes the merge read, per file kind (feature store, tiles, the rest); without strace
 //! those columns are NaN. Every merged graph is compared with `graph build` of the same clips
 //! (built in this process) byte for byte.
+//!
+//! Two columns model the growth: style seconds per edge kept, and the memory the merge must
+//! hold at its peak (the measurements and the style vectors, 2 × 456 bytes per window, and 28
+//! bytes per edge kept: 12 as a candidate, 16 as an edge), to set beside the measured peak.
 
 use std::path::Path;
 use std::process::Command;
@@ -114,7 +118,10 @@ pub fn run(libraries: &[Vec<GraphClip>], runs: usize) -> Result<()> {
         if has_strace { "" } else { " (no strace here: NaN)" }
     );
     println!(
-        "{:>8} {:>5} {:>10} {:>9} | {:>7} {:>6} {:>6} {:>6} {:>5} | {:>8} {:>8} {:>8} {:>8}",
+        "(MiB: peak resident; model: what the merge must hold, MiB; store MB: the store's size, then MB read from it, from the tiles and from other files)"
+    );
+    println!(
+        "{:>8} {:>5} {:>10} {:>9} | {:>7} {:>6} {:>6} {:>6} {:>5} | {:>7} {:>5} | {:>8} {:>8} {:>8} {:>8}",
         "frames",
         "tiles",
         "minima",
@@ -124,6 +131,8 @@ pub fn run(libraries: &[Vec<GraphClip>], runs: usize) -> Result<()> {
         "style",
         "cpu s",
         "MiB",
+        "µs/edge",
+        "model",
         "store MB",
         "read MB",
         "tiles MB",
@@ -174,16 +183,21 @@ pub fn run(libraries: &[Vec<GraphClip>], runs: usize) -> Result<()> {
                 other: f64::NAN,
             }
         };
+        let edges = count(" transitions");
+        let model_mib =
+            (2.0 * 456.0 * planned.manifest.windows as f64 + 28.0 * edges) / (1024.0 * 1024.0);
         println!(
-            "{n:>8} {:>5} {:>10.0} {:>9.0} | {:>7.3} {:>6.3} {:>6.3} {:>6.2} {:>5.0} | {:>8.1} {:>8.1} {:>8.1} {:>8.1}",
+            "{n:>8} {:>5} {:>10.0} {:>9.0} | {:>7.3} {:>6.3} {:>6.3} {:>6.2} {:>5.0} | {:>7.2} {:>5.0} | {:>8.1} {:>8.1} {:>8.1} {:>8.1}",
             planned.manifest.tiles.len(),
             count(" local maxima"),
-            count(" transitions"),
+            edges,
             median(walls),
             field("read "),
             field("style "),
             field("cpu "),
             field("peak "),
+            field("style ") / edges * 1e6,
+            model_mib,
             planned.store_bytes as f64 / 1e6,
             read.store / 1e6,
             read.tiles / 1e6,

@@ -53,6 +53,14 @@ pub(super) fn read_at(
     at: u64,
     len: usize,
 ) -> Result<Vec<u8>, GraphError> {
+    // Lengths come from the file itself: a damaged one must not make us allocate gigabytes.
+    let size = file.metadata().map_err(|e| err(path, e))?.len();
+    if at.checked_add(len as u64).is_none_or(|end| end > size) {
+        return Err(err(
+            path,
+            format!("{len} bytes at {at} lie past the end of the file ({size} bytes): cut short?"),
+        ));
+    }
     let mut buf = vec![0u8; len];
     file.seek(SeekFrom::Start(at))
         .and_then(|_| file.read_exact(&mut buf))
@@ -125,9 +133,18 @@ pub(super) fn read_message(
         _ => return Err(err(path, format!("record batch {k}: bad block"))),
     };
     let bytes = read_at(file, path, offset, meta_len)?;
+    let size = file.metadata().map_err(|e| err(path, e))?.len();
     let body_at = offset
         .checked_add(meta_len as u64)
-        .ok_or_else(|| err(path, format!("record batch {k}: bad block")))?;
+        .filter(|at| at.checked_add(body_len).is_some_and(|end| end <= size))
+        .ok_or_else(|| {
+            err(
+                path,
+                format!(
+                    "record batch {k} lies past the end of the file ({size} bytes): cut short?"
+                ),
+            )
+        })?;
     Ok((bytes, body_at, body_len))
 }
 

@@ -35,13 +35,12 @@ use arrow_array::cast::AsArray;
 use arrow_array::types::{Float32Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, FixedSizeListArray, Float32Array, RecordBatch, UInt32Array};
 use arrow_buffer::NullBuffer;
-use arrow_ipc::reader::FileReader;
 use arrow_ipc::writer::FileWriter;
 use arrow_schema::{DataType, Field, Schema};
 use glam::Vec3;
 
 use super::ipc_floats::TrailingFloatRows;
-use super::ipc_prefix::LeadingColumns;
+use super::ipc_prefix::{read_footer, LeadingColumns};
 use super::lma::MEASUREMENTS;
 use super::posture::WindowTerms;
 use super::roles::Role;
@@ -214,8 +213,9 @@ impl Store {
             path: path.to_path_buf(),
             frames,
         };
-        let r = s.reader()?;
-        let found_schema = r.schema();
+        // Only the footer: schema and batch list, its lengths checked against the file's size.
+        let footer = read_footer(path)?;
+        let found_schema = &footer.schema;
         let meta = found_schema.metadata();
         if meta.get(KEY_FORMAT).map(String::as_str) != Some(FORMAT) {
             return Err(arrow_err(path, "not a figurine feature store"));
@@ -240,23 +240,17 @@ impl Store {
         if *found_schema != schema(plan) {
             return Err(arrow_err(path, "unexpected columns"));
         }
-        if r.num_batches() != frames.div_ceil(BATCH_ROWS) {
+        if footer.blocks.len() != frames.div_ceil(BATCH_ROWS) {
             return Err(arrow_err(
                 path,
                 format!(
                     "{} record batches, the plan's {frames} frames need {}",
-                    r.num_batches(),
+                    footer.blocks.len(),
                     frames.div_ceil(BATCH_ROWS)
                 ),
             ));
         }
         Ok(s)
-    }
-
-    /// arrow-ipc's reader of the file: it reads the footer (schema, batch list) at once.
-    fn reader(&self) -> Result<FileReader<std::io::BufReader<File>>, GraphError> {
-        let file = File::open(&self.path).map_err(|e| io_err(&self.path, e))?;
-        FileReader::try_new_buffered(file, None).map_err(|e| arrow_err(&self.path, e))
     }
 
     /// Checks that record batch `b`, number `k`, has the expected row count.
@@ -402,6 +396,46 @@ mod tests {
         let d = std::env::temp_dir().join(format!("figurine-store-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&d).unwrap();
         d.join("features.arrow")
+    }
+
+    /// The seed of the `graph_store` fuzz target: a frame count (u32) and a plan id (u64),
+    /// little-endian, then the store of one 60-frame clip. Written again with
+    /// FIGURINE_WRITE_FUZZ_SEEDS=1 (after a change of the store or of the features).
+    #[test]
+    fn the_fuzz_seed_is_a_store_the_readers_accept() {
+        let seed =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/graph_store/one-clip.bin");
+        if std::env::var_os("FIGURINE_WRITE_FUZZ_SEEDS").is_some() {
+            let clips = vec![fake_clip("a", synthetic(60, 0.8, 0.3))];
+            let path = tmp("seed");
+            write_store(
+                &path,
+                &FrameRows::from_clips(&clips),
+                &measurements(&clips),
+                7,
+            )
+            .unwrap();
+            let mut bytes = 60u32.to_le_bytes().to_vec();
+            bytes.extend(7u64.to_le_bytes());
+            bytes.extend(std::fs::read(&path).unwrap());
+            std::fs::create_dir_all(seed.parent().unwrap()).unwrap();
+            std::fs::write(&seed, bytes).unwrap();
+            std::fs::remove_dir_all(path.parent().unwrap()).ok();
+        }
+        // What the fuzz target does with it, on the success path all the way.
+        let bytes = std::fs::read(&seed).unwrap();
+        let frames = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
+        let plan = u64::from_le_bytes(bytes[4..12].try_into().unwrap());
+        let path = tmp("seed-read");
+        std::fs::write(&path, &bytes[12..]).unwrap();
+        let s = Store::open(&path, plan, frames).unwrap();
+        assert_eq!(s.rows(0..frames).unwrap().clip_of.len(), frames);
+        let windows = frames + 1 - crate::graph::WINDOW;
+        assert_eq!(
+            s.measurements(windows).unwrap().0.len(),
+            windows * MEASUREMENTS
+        );
+        std::fs::remove_dir_all(path.parent().unwrap()).ok();
     }
 
     #[test]
