@@ -3,9 +3,10 @@
 //! Merge first checks the whole job: the manifest, the feature store, and that every tile file
 //! exists, belongs to this plan and is intact. A job with missing tiles is refused with the list
 //! of missing files (the array tasks to re-run); a damaged or foreign tile is refused by name.
-//! Then it joins the tiles' candidates, reads the LMA measurements from the store and calls the
-//! same [`assemble`] as `graph build`, so the file is byte-identical to a single-machine build
-//! of the same clips and options.
+//! Then it joins the tiles' candidates, reads the LMA measurements from the store (only that
+//! column, only its window rows: [`super::ipc_floats`]) and calls the same [`assemble`] as
+//! `graph build`, so the file is byte-identical to a single-machine build of the same clips and
+//! options.
 //!
 //! Tiles are read twice: headers first (the library-wide distance range), then the candidates,
 //! keeping only those that pass T_MG. Memory is therefore the edges (12 bytes per candidate

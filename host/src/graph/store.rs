@@ -17,7 +17,8 @@
 //!
 //! Rows come in record batches of [`BATCH_ROWS`] (the last one shorter), so a tile reads only
 //! the batches its bands touch, and only the bytes of the columns it needs
-//! ([`super::ipc_prefix`]). Size: 4 + 192 + 12 + 456 bytes
+//! ([`super::ipc_prefix`]); the merge reads only the `lma` values of window centres
+//! ([`super::ipc_floats`]). Size: 4 + 192 + 12 + 456 bytes
 //! of values per frame plus validity bits and padding, about 664 MB (633 MiB) per million
 //! frames, uncompressed (compression would add codecs to the build for data that compresses
 //! poorly: f32 motion).
