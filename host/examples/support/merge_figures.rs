@@ -40,7 +40,11 @@ fn bytes_read(log: &str) -> BytesRead {
         other: 0.0,
     };
     for line in log.lines() {
-        if !(line.contains("read(") || line.contains("read64(")) {
+        if !(line.contains("read(")
+            || line.contains("read64(")
+            || line.contains("read resumed>")
+            || line.contains("read64 resumed>"))
+        {
             continue;
         }
         // A call interrupted by another thread's line is completed on a "resumed" line, which
