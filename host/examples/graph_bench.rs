@@ -17,6 +17,11 @@
 //! RUNS BAND…` runs one library size with the given bands (frames) RUNS times. It needs the
 //! release `figurine` binary beside the examples folder (`cargo build --release -p
 //! figurine-host --bin figurine`).
+//!
+//! `… -- merge [RUNS [FRAMES…]]` plans and tiles libraries of 27k, 54k and 108k frames (or
+//! FRAMES…) and times `figurine graph merge` on each (RUNS merges, default 3): wall, CPU, peak
+//! memory and bytes read against the local minima and edges (see `support/merge_figures.rs`);
+//! it needs the same release binary.
 
 use std::process::Command;
 use std::time::Instant;
@@ -25,6 +30,8 @@ use std::time::Instant;
 mod engine;
 #[path = "support/engine_figures.rs"]
 mod figures;
+#[path = "support/merge_figures.rs"]
+mod merge_figures;
 #[path = "support/slurm_log.rs"]
 mod slurm_log;
 #[path = "../tests/support/mod.rs"]
@@ -129,6 +136,23 @@ fn main() -> anyhow::Result<()> {
         )?;
         println!("\n108,000 frames:");
         return engine::run(&library(&base, 108_000), &[DEFAULT_BAND], 1, false);
+    }
+    if args.first().map(String::as_str) == Some("merge") {
+        let paths = FILES
+            .iter()
+            .map(|f| require_data_file("bvh", f))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let base = load_clips(&paths, &Default::default())?;
+        let runs = args.get(1).map(|r| r.parse()).transpose()?.unwrap_or(3);
+        let sizes = match args.get(2..) {
+            Some(s) if !s.is_empty() => s
+                .iter()
+                .map(|f| f.parse())
+                .collect::<Result<Vec<usize>, _>>()?,
+            _ => vec![27_000, 54_000, 108_000],
+        };
+        let libraries: Vec<Vec<GraphClip>> = sizes.iter().map(|&f| library(&base, f)).collect();
+        return merge_figures::run(&libraries, runs);
     }
     if let Some(arg) = args.first() {
         return one(arg.parse()?);

@@ -105,6 +105,14 @@ const TARGETS: &[Target] = &[
         real_seeds: &[],
         max_len: 0,
     },
+    // Seed: a one-clip feature store with its frame count and plan id in front (written by
+    // `graph::store`'s tests with FIGURINE_WRITE_FUZZ_SEEDS=1). Inputs up to twice its size.
+    Target {
+        dir: "host/fuzz",
+        name: "graph_store",
+        real_seeds: &[],
+        max_len: 96 * 1024,
+    },
     Target {
         dir: "firmware/recognizer/fuzz",
         name: "sample_feed",

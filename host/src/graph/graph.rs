@@ -253,15 +253,23 @@ impl MotionGraph {
     }
 
     /// Writes the graph file.
+    ///
+    /// The encoding streams into the file: encoding into memory first held the file's bytes
+    /// (~29 MB at 54k frames) up to three times over (the growing body, then the body copied
+    /// behind the header), and that was a `graph merge`'s peak: 114 MiB at 54k frames, 69 MiB
+    /// streamed.
     pub fn save(&self, path: &Path) -> Result<(), GraphError> {
-        let mut bytes = MAGIC.to_vec();
-        let body = postcard::to_allocvec(self)
-            .map_err(|e| GraphError::format(path, format!("encoding the graph: {e}")))?;
-        bytes.extend(body);
-        std::fs::write(path, bytes).map_err(|source| GraphError::Io {
+        use std::io::Write;
+        let io = |source| GraphError::Io {
             path: path.to_path_buf(),
             source,
-        })
+        };
+        let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+        w.write_all(MAGIC).map_err(io)?;
+        let w = postcard::to_io(self, w)
+            .map_err(|e| GraphError::format(path, format!("encoding the graph: {e}")))?;
+        w.into_inner().map_err(|e| io(e.into_error()))?;
+        Ok(())
     }
 
     /// Reads a graph file.
@@ -440,6 +448,10 @@ pub(crate) mod tests {
         let p = dir.join("g.bin");
         g.save(&p).unwrap();
         assert_eq!(MotionGraph::load(&p).unwrap(), g);
+        // The streamed file is the format's bytes: the header, then postcard's encoding.
+        let mut want = MAGIC.to_vec();
+        want.extend(postcard::to_allocvec(&g).unwrap());
+        assert_eq!(std::fs::read(&p).unwrap(), want);
         std::fs::write(&p, b"garbage").unwrap();
         assert!(MotionGraph::load(&p)
             .unwrap_err()

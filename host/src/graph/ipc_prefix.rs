@@ -41,16 +41,125 @@ pub struct LeadingColumns {
     read: u64,
 }
 
-fn err(path: &Path, what: impl std::fmt::Display) -> GraphError {
+/// An error about feature store `path`.
+pub(super) fn err(path: &Path, what: impl std::fmt::Display) -> GraphError {
     GraphError::format(path, format!("feature store: {what}"))
 }
 
-fn read_at(file: &mut File, path: &Path, at: u64, len: usize) -> Result<Vec<u8>, GraphError> {
+/// `len` bytes of `file` (at `path`) from byte `at`.
+pub(super) fn read_at(
+    file: &mut File,
+    path: &Path,
+    at: u64,
+    len: usize,
+) -> Result<Vec<u8>, GraphError> {
+    // Lengths come from the file itself: a damaged one must not make us allocate gigabytes.
+    let size = file.metadata().map_err(|e| err(path, e))?.len();
+    if at.checked_add(len as u64).is_none_or(|end| end > size) {
+        return Err(err(
+            path,
+            format!("{len} bytes at {at} lie past the end of the file ({size} bytes): cut short?"),
+        ));
+    }
     let mut buf = vec![0u8; len];
     file.seek(SeekFrom::Start(at))
         .and_then(|_| file.read_exact(&mut buf))
         .map_err(|e| err(path, format!("reading {len} bytes at {at}: {e}")))?;
     Ok(buf)
+}
+
+/// What an IPC file's footer holds: its schema, format version and record batch blocks.
+pub(super) struct Footer {
+    /// The file, open for reading.
+    pub file: File,
+    pub schema: arrow_schema::Schema,
+    pub version: arrow_ipc::MetadataVersion,
+    /// Where each record batch lies: message offset, message length, body length (bytes).
+    pub blocks: Vec<Block>,
+    /// Whether the file says its buffers are little-endian.
+    pub little_endian: bool,
+}
+
+/// Opens `path` and reads its footer (the last bytes of the file only).
+pub(super) fn read_footer(path: &Path) -> Result<Footer, GraphError> {
+    let mut file = File::open(path).map_err(|source| GraphError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let len = file.metadata().map_err(|e| err(path, e))?.len();
+    if len < TRAILER {
+        return Err(err(path, "shorter than an Arrow IPC trailer"));
+    }
+    let mut trailer = [0u8; TRAILER as usize];
+    trailer.copy_from_slice(&read_at(&mut file, path, len - TRAILER, TRAILER as usize)?);
+    let footer_len = read_footer_length(trailer).map_err(|e| err(path, e))? as u64;
+    let start = len
+        .checked_sub(TRAILER + footer_len)
+        .ok_or_else(|| err(path, "footer longer than the file"))?;
+    let bytes = read_at(&mut file, path, start, footer_len as usize)?;
+    let footer = arrow_ipc::root_as_footer(&bytes).map_err(|e| err(path, e))?;
+    let fb_schema = footer
+        .schema()
+        .ok_or_else(|| err(path, "no schema in the footer"))?;
+    let little_endian = fb_schema.endianness() == arrow_ipc::Endianness::Little;
+    let schema = arrow_ipc::convert::try_fb_to_schema(fb_schema).map_err(|e| err(path, e))?;
+    let blocks = footer
+        .recordBatches()
+        .map(|b| b.iter().copied().collect())
+        .unwrap_or_default();
+    Ok(Footer {
+        file,
+        schema,
+        version: footer.version(),
+        blocks,
+        little_endian,
+    })
+}
+
+/// The message of record batch `k` at `block` (read from `file`, at `path`) as raw bytes with
+/// its 8-byte prefix, where its body starts and the body's length, bytes.
+pub(super) fn read_message(
+    file: &mut File,
+    path: &Path,
+    block: &Block,
+    k: usize,
+) -> Result<(Vec<u8>, u64, u64), GraphError> {
+    let (offset, meta_len, body_len) = match (
+        u64::try_from(block.offset()),
+        usize::try_from(block.metaDataLength()),
+        u64::try_from(block.bodyLength()),
+    ) {
+        (Ok(o), Ok(m), Ok(b)) => (o, m, b),
+        _ => return Err(err(path, format!("record batch {k}: bad block"))),
+    };
+    let bytes = read_at(file, path, offset, meta_len)?;
+    let size = file.metadata().map_err(|e| err(path, e))?.len();
+    let body_at = offset
+        .checked_add(meta_len as u64)
+        .filter(|at| at.checked_add(body_len).is_some_and(|end| end <= size))
+        .ok_or_else(|| {
+            err(
+                path,
+                format!(
+                    "record batch {k} lies past the end of the file ({size} bytes): cut short?"
+                ),
+            )
+        })?;
+    Ok((bytes, body_at, body_len))
+}
+
+/// The record batch header inside message bytes `meta` (with their 8-byte prefix).
+pub(super) fn record_batch<'a>(
+    meta: &'a [u8],
+    path: &Path,
+) -> Result<arrow_ipc::RecordBatch<'a>, GraphError> {
+    let flat = meta
+        .get(MESSAGE_PREFIX..)
+        .ok_or_else(|| err(path, "record batch message cut short"))?;
+    let message = arrow_ipc::root_as_message(flat).map_err(|e| err(path, e))?;
+    message
+        .header_as_record_batch()
+        .ok_or_else(|| err(path, "a record batch block holds another message"))
 }
 
 impl LeadingColumns {
@@ -62,38 +171,14 @@ impl LeadingColumns {
         leading_buffers: usize,
         all_buffers: usize,
     ) -> Result<LeadingColumns, GraphError> {
-        let mut file = File::open(path).map_err(|source| GraphError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let len = file.metadata().map_err(|e| err(path, e))?.len();
-        if len < TRAILER {
-            return Err(err(path, "shorter than an Arrow IPC trailer"));
-        }
-        let mut trailer = [0u8; TRAILER as usize];
-        trailer.copy_from_slice(&read_at(&mut file, path, len - TRAILER, TRAILER as usize)?);
-        let footer_len = read_footer_length(trailer).map_err(|e| err(path, e))? as u64;
-        let start = len
-            .checked_sub(TRAILER + footer_len)
-            .ok_or_else(|| err(path, "footer longer than the file"))?;
-        let bytes = read_at(&mut file, path, start, footer_len as usize)?;
-        let footer = arrow_ipc::root_as_footer(&bytes).map_err(|e| err(path, e))?;
-        let schema = footer
-            .schema()
-            .map(arrow_ipc::convert::try_fb_to_schema)
-            .ok_or_else(|| err(path, "no schema in the footer"))?
-            .map_err(|e| err(path, e))?;
-        let blocks = footer
-            .recordBatches()
-            .map(|b| b.iter().copied().collect())
-            .unwrap_or_default();
-        let decoder = FileDecoder::new(Arc::new(schema), footer.version())
-            .with_projection((0..columns).collect());
+        let f = read_footer(path)?;
+        let decoder =
+            FileDecoder::new(Arc::new(f.schema), f.version).with_projection((0..columns).collect());
         Ok(LeadingColumns {
             path: path.to_path_buf(),
-            file,
+            file: f.file,
             decoder,
-            blocks,
+            blocks: f.blocks,
             leading_buffers,
             all_buffers,
             read: 0,
@@ -113,16 +198,7 @@ impl LeadingColumns {
     /// Bytes of record batch `k`'s body that hold the leading columns, or the whole body when
     /// the message is not laid out as expected.
     fn body_prefix(&self, meta: &[u8], body_len: u64) -> Result<u64, GraphError> {
-        let flat = meta
-            .get(MESSAGE_PREFIX..)
-            .ok_or_else(|| err(&self.path, "record batch message cut short"))?;
-        let message = arrow_ipc::root_as_message(flat).map_err(|e| err(&self.path, e))?;
-        let Some(batch) = message.header_as_record_batch() else {
-            return Err(err(
-                &self.path,
-                "a record batch block holds another message",
-            ));
-        };
+        let batch = record_batch(meta, &self.path)?;
         let buffers = batch.buffers().map(|b| b.iter().collect::<Vec<_>>());
         match buffers {
             Some(b) if batch.compression().is_none() && b.len() == self.all_buffers => {
@@ -148,19 +224,8 @@ impl LeadingColumns {
             .blocks
             .get(k)
             .ok_or_else(|| err(&self.path, format!("record batch {k} missing")))?;
-        let (offset, meta_len, body_len) = match (
-            u64::try_from(block.offset()),
-            usize::try_from(block.metaDataLength()),
-            u64::try_from(block.bodyLength()),
-        ) {
-            (Ok(o), Ok(m), Ok(b)) => (o, m, b),
-            _ => return Err(err(&self.path, format!("record batch {k}: bad block"))),
-        };
-        let mut bytes = read_at(&mut self.file, &self.path, offset, meta_len)?;
+        let (mut bytes, body_at, body_len) = read_message(&mut self.file, &self.path, &block, k)?;
         let prefix = self.body_prefix(&bytes, body_len)?;
-        let body_at = offset
-            .checked_add(meta_len as u64)
-            .ok_or_else(|| err(&self.path, format!("record batch {k}: bad block")))?;
         // Read into the message's own vector: one allocation for the batch, no copy.
         let at = bytes.len();
         bytes.resize(at + prefix as usize, 0);

@@ -170,7 +170,7 @@ pub(super) fn merge_cmd(a: MergeArgs) -> anyhow::Result<()> {
     })?;
     if !a.quiet {
         println!(
-            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.3} s, style {:.3} s, total {:.3} s, cpu {:.2} s, peak {:.0} MiB; wrote {}",
+            "{} tiles, {} window pairs, {} local maxima, {} transitions (MG); read {:.3} s, style {:.3} s, total {:.3} s, cpu {:.2} s, peak {:.0} MiB, store bytes {:.1} MB; wrote {}",
             st.tiles,
             st.pairs,
             st.local_minima,
@@ -180,6 +180,7 @@ pub(super) fn merge_cmd(a: MergeArgs) -> anyhow::Result<()> {
             t0.elapsed().as_secs_f64(),
             cpu_seconds().unwrap_or(f64::NAN),
             peak_memory_mib().unwrap_or(f64::NAN),
+            st.store_bytes_read as f64 / 1e6,
             a.out.display()
         );
     }

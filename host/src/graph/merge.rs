@@ -3,9 +3,10 @@
 //! Merge first checks the whole job: the manifest, the feature store, and that every tile file
 //! exists, belongs to this plan and is intact. A job with missing tiles is refused with the list
 //! of missing files (the array tasks to re-run); a damaged or foreign tile is refused by name.
-//! Then it joins the tiles' candidates, reads the LMA measurements from the store and calls the
-//! same [`assemble`] as `graph build`, so the file is byte-identical to a single-machine build
-//! of the same clips and options.
+//! Then it joins the tiles' candidates, reads the LMA measurements from the store (only that
+//! column, only its window rows: [`super::ipc_floats`]) and calls the same [`assemble`] as
+//! `graph build`, so the file is byte-identical to a single-machine build of the same clips and
+//! options.
 //!
 //! Tiles are read twice: headers first (the library-wide distance range), then the candidates,
 //! keeping only those that pass T_MG. Memory is therefore the edges (12 bytes per candidate
@@ -36,8 +37,10 @@ pub struct MergeStats {
     pub pairs: u64,
     /// Local minima the tiles found.
     pub local_minima: usize,
-    /// Seconds reading and checking tiles.
+    /// Seconds reading and checking tiles, and reading the measurements from the store.
     pub read_seconds: f64,
+    /// Bytes read from the feature store for the measurements.
+    pub store_bytes_read: u64,
     /// Seconds assembling the graph (style similarity of the survivors).
     pub assemble_seconds: f64,
 }
@@ -92,7 +95,8 @@ pub fn merge_job(job: &Path) -> Result<(MotionGraph, MergeStats), GraphError> {
     }
     // Tiles are disjoint and each sorted; one sort makes the order independent of tile order.
     let found = found.sorted();
-    let measurements = store.measurements(m.windows)?;
+    let (measurements, store_bytes_read) = store.measurements(m.windows)?;
+    stats.store_bytes_read = store_bytes_read;
     stats.read_seconds = t0.elapsed().as_secs_f64();
     stats.pairs = found.pairs;
     stats.local_minima = minima as usize;

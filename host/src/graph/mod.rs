@@ -31,6 +31,7 @@ pub mod eval;
 #[allow(clippy::module_inception)]
 pub mod graph;
 pub mod inputs;
+pub mod ipc_floats;
 pub mod ipc_prefix;
 mod job_cli;
 pub mod lma;

@@ -17,7 +17,8 @@
 //!
 //! Rows come in record batches of [`BATCH_ROWS`] (the last one shorter), so a tile reads only
 //! the batches its bands touch, and only the bytes of the columns it needs
-//! ([`super::ipc_prefix`]). Size: 4 + 192 + 12 + 456 bytes
+//! ([`super::ipc_prefix`]); the merge reads only the `lma` values of window centres
+//! ([`super::ipc_floats`]). Size: 4 + 192 + 12 + 456 bytes
 //! of values per frame plus validity bits and padding, about 664 MB (633 MiB) per million
 //! frames, uncompressed (compression would add codecs to the build for data that compresses
 //! poorly: f32 motion).
@@ -35,12 +36,12 @@ use arrow_array::cast::AsArray;
 use arrow_array::types::{Float32Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, FixedSizeListArray, Float32Array, RecordBatch, UInt32Array};
 use arrow_buffer::NullBuffer;
-use arrow_ipc::reader::FileReader;
 use arrow_ipc::writer::FileWriter;
 use arrow_schema::{DataType, Field, Schema};
 use glam::Vec3;
 
-use super::ipc_prefix::LeadingColumns;
+use super::ipc_floats::TrailingFloatRows;
+use super::ipc_prefix::{read_footer, LeadingColumns};
 use super::lma::MEASUREMENTS;
 use super::posture::WindowTerms;
 use super::roles::Role;
@@ -54,6 +55,8 @@ pub const STORE_VERSION: u32 = 1;
 const SEARCH_BUFFERS: usize = 11;
 /// IPC buffers of a whole record batch: those and the `lma` column's 3.
 const ALL_BUFFERS: usize = 14;
+/// Field nodes of a whole record batch: one per column, and one for each list's items.
+const ALL_NODES: usize = 8;
 /// Rows per record batch (the last batch of a file may be shorter).
 pub const BATCH_ROWS: usize = 65_536;
 /// Floats per frame in the `points` column (16 role points × x y z).
@@ -211,8 +214,9 @@ impl Store {
             path: path.to_path_buf(),
             frames,
         };
-        let r = s.reader(None)?;
-        let found_schema = r.schema();
+        // Only the footer: schema and batch list, its lengths checked against the file's size.
+        let footer = read_footer(path)?;
+        let found_schema = &footer.schema;
         let meta = found_schema.metadata();
         if meta.get(KEY_FORMAT).map(String::as_str) != Some(FORMAT) {
             return Err(arrow_err(path, "not a figurine feature store"));
@@ -237,40 +241,17 @@ impl Store {
         if *found_schema != schema(plan) {
             return Err(arrow_err(path, "unexpected columns"));
         }
-        if r.num_batches() != frames.div_ceil(BATCH_ROWS) {
+        if footer.blocks.len() != frames.div_ceil(BATCH_ROWS) {
             return Err(arrow_err(
                 path,
                 format!(
                     "{} record batches, the plan's {frames} frames need {}",
-                    r.num_batches(),
+                    footer.blocks.len(),
                     frames.div_ceil(BATCH_ROWS)
                 ),
             ));
         }
         Ok(s)
-    }
-
-    fn reader(
-        &self,
-        projection: Option<Vec<usize>>,
-    ) -> Result<FileReader<std::io::BufReader<File>>, GraphError> {
-        let file = File::open(&self.path).map_err(|e| io_err(&self.path, e))?;
-        FileReader::try_new_buffered(file, projection).map_err(|e| arrow_err(&self.path, e))
-    }
-
-    /// Record batch `k` with columns `projection`, checked to have the expected row count.
-    fn batch(
-        &self,
-        r: &mut FileReader<std::io::BufReader<File>>,
-        k: usize,
-    ) -> Result<RecordBatch, GraphError> {
-        r.set_index(k).map_err(|e| arrow_err(&self.path, e))?;
-        let b = r
-            .next()
-            .ok_or_else(|| arrow_err(&self.path, format!("record batch {k} missing")))?
-            .map_err(|e| arrow_err(&self.path, format!("record batch {k}: {e}")))?;
-        self.check_rows(&b, k)?;
-        Ok(b)
     }
 
     /// Checks that record batch `b`, number `k`, has the expected row count.
@@ -351,40 +332,46 @@ impl Store {
     }
 
     /// The raw LMA measurements of every window (`windows × 114`, global order), checked to be
-    /// `windows` rows.
-    pub fn measurements(&self, windows: usize) -> Result<Vec<f32>, GraphError> {
-        let mut r = self.reader(Some(vec![5]))?;
-        let mut out = Vec::with_capacity(windows * MEASUREMENTS);
+    /// `windows` rows, and the bytes read from the file for them.
+    ///
+    /// Only the `lma` column is read, and of it only the rows of window centres: 456 bytes per
+    /// window of the 664 per frame, straight into the returned vector ([`super::ipc_floats`]).
+    pub fn measurements(&self, windows: usize) -> Result<(Vec<f32>, u64), GraphError> {
+        if windows > self.frames {
+            return Err(arrow_err(
+                &self.path,
+                format!(
+                    "the plan's {windows} windows exceed its {} frames",
+                    self.frames
+                ),
+            ));
+        }
+        let mut r = TrailingFloatRows::open(&self.path, MEASUREMENTS, ALL_NODES, ALL_BUFFERS)?;
+        let mut out = Vec::new();
+        out.try_reserve_exact(windows * MEASUREMENTS)
+            .map_err(|e| arrow_err(&self.path, format!("{windows} windows: {e}")))?;
         for k in 0..self.frames.div_ceil(BATCH_ROWS) {
-            let b = self.batch(&mut r, k)?;
-            let lma = b
-                .column(0)
-                .as_fixed_size_list_opt()
-                .ok_or_else(|| arrow_err(&self.path, "bad `lma` column"))?;
-            let v = lma
-                .values()
-                .as_primitive_opt::<Float32Type>()
-                .ok_or_else(|| arrow_err(&self.path, "bad `lma` column"))?;
-            for i in 0..lma.len() {
-                if lma.is_valid(i) {
-                    let row = v
-                        .values()
-                        .get(lma.value_offset_at(i)..lma.value_offset_at(i + 1))
-                        .ok_or_else(|| arrow_err(&self.path, "short `lma` column"))?;
-                    out.extend_from_slice(row);
-                }
+            let rows = (self.frames - k * BATCH_ROWS).min(BATCH_ROWS);
+            r.append_batch(k, rows, &mut out)?;
+            if out.len() > windows * MEASUREMENTS {
+                break;
             }
         }
         if out.len() != windows * MEASUREMENTS {
             return Err(arrow_err(
                 &self.path,
                 format!(
-                    "{} windows, the plan has {windows}",
+                    "{}{} windows, the plan has {windows}",
+                    if out.len() > windows * MEASUREMENTS {
+                        "more than "
+                    } else {
+                        ""
+                    },
                     out.len() / MEASUREMENTS
                 ),
             ));
         }
-        Ok(out)
+        Ok((out, r.bytes_read()))
     }
 }
 
@@ -412,6 +399,46 @@ mod tests {
         d.join("features.arrow")
     }
 
+    /// The seed of the `graph_store` fuzz target: a frame count (u32) and a plan id (u64),
+    /// little-endian, then the store of one 60-frame clip. Written again with
+    /// FIGURINE_WRITE_FUZZ_SEEDS=1 (after a change of the store or of the features).
+    #[test]
+    fn the_fuzz_seed_is_a_store_the_readers_accept() {
+        let seed =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/graph_store/one-clip.bin");
+        if std::env::var_os("FIGURINE_WRITE_FUZZ_SEEDS").is_some() {
+            let clips = vec![fake_clip("a", synthetic(60, 0.8, 0.3))];
+            let path = tmp("seed");
+            write_store(
+                &path,
+                &FrameRows::from_clips(&clips),
+                &measurements(&clips),
+                7,
+            )
+            .unwrap();
+            let mut bytes = 60u32.to_le_bytes().to_vec();
+            bytes.extend(7u64.to_le_bytes());
+            bytes.extend(std::fs::read(&path).unwrap());
+            std::fs::create_dir_all(seed.parent().unwrap()).unwrap();
+            std::fs::write(&seed, bytes).unwrap();
+            std::fs::remove_dir_all(path.parent().unwrap()).ok();
+        }
+        // What the fuzz target does with it, on the success path all the way.
+        let bytes = std::fs::read(&seed).unwrap();
+        let frames = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
+        let plan = u64::from_le_bytes(bytes[4..12].try_into().unwrap());
+        let path = tmp("seed-read");
+        std::fs::write(&path, &bytes[12..]).unwrap();
+        let s = Store::open(&path, plan, frames).unwrap();
+        assert_eq!(s.rows(0..frames).unwrap().clip_of.len(), frames);
+        let windows = frames + 1 - crate::graph::WINDOW;
+        assert_eq!(
+            s.measurements(windows).unwrap().0.len(),
+            windows * MEASUREMENTS
+        );
+        std::fs::remove_dir_all(path.parent().unwrap()).ok();
+    }
+
     #[test]
     fn round_trip_is_bit_exact_for_any_range() {
         let (rows, meas) = library();
@@ -424,7 +451,12 @@ mod tests {
         assert_eq!(part.base, 20);
         assert_eq!(part.points, rows.points[20..77]);
         assert_eq!(part.terms, rows.terms[20..77]);
-        let back = s.measurements(meas.len() / MEASUREMENTS).unwrap();
+        let (back, read) = s.measurements(meas.len() / MEASUREMENTS).unwrap();
+        // The measurements' own bytes and little more (messages, a validity bitmap).
+        assert!(
+            read >= 4 * meas.len() as u64 && read < 4 * meas.len() as u64 + 1024,
+            "{read}"
+        );
         assert_eq!(
             back.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             meas.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
