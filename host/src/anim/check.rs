@@ -639,13 +639,16 @@ pub fn print_table(rows: &[Plausibility]) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::motion::{Joint, Pose};
 
+    /// Index of [`figure`]'s spine joint.
+    pub(crate) const SPINE: usize = 9;
+
     /// A stick figure facing +Z (left towards +X), 1.7 m tall, standing with its soles on the
     /// ground: `pose(f, &mut Pose)` animates frame `f` of `frames` at 30 fps.
-    fn figure(frames: usize, pose: impl Fn(usize, &mut Pose)) -> Clip {
+    pub(crate) fn figure(frames: usize, pose: impl Fn(usize, &mut Pose)) -> Clip {
         let j = |name: &str, parent: Option<usize>, o: [f32; 3]| {
             Joint::bare(name, parent, Vec3::from(o))
         };

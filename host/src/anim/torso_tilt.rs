@@ -138,7 +138,6 @@ pub fn hold_torso_tilt(src: &Clip, out: &mut Clip, margin_deg: f32) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::{Joint, Skeleton};
     use glam::Quat;
 
     #[test]
@@ -157,46 +156,12 @@ mod tests {
         assert_eq!(TiltFigures::of(&[]), TiltFigures { p95: 0.0, max: 0.0 });
     }
 
-    /// A torso (hips → spine → neck → head) with legs and arms, its spine bent forward by
-    /// `bends[f]` rad about +X in frame `f`.
+    /// `check`'s stick figure with its spine bent forward by `bends[f]` rad about +X in
+    /// frame `f`.
     fn torso(bends: &[f32]) -> Clip {
-        let j = |name: &str, parent: Option<usize>, o: [f32; 3]| {
-            Joint::bare(name, parent, Vec3::from(o))
-        };
-        let skeleton = Skeleton {
-            joints: vec![
-                j("Hips", None, [0.0, 0.9, 0.0]),
-                j("LeftUpLeg", Some(0), [0.1, 0.0, 0.0]),
-                j("LeftLeg", Some(1), [0.0, -0.42, 0.0]),
-                j("LeftFoot", Some(2), [0.0, -0.42, 0.0]),
-                j("RightUpLeg", Some(0), [-0.1, 0.0, 0.0]),
-                j("RightLeg", Some(4), [0.0, -0.42, 0.0]),
-                j("RightFoot", Some(5), [0.0, -0.42, 0.0]),
-                j("Spine", Some(0), [0.0, 0.2, 0.0]),
-                j("Neck", Some(7), [0.0, 0.35, 0.0]),
-                j("Head", Some(8), [0.0, 0.2, 0.0]),
-                j("LeftArm", Some(7), [0.18, 0.3, 0.0]),
-                j("LeftForeArm", Some(10), [0.0, -0.28, 0.0]),
-                j("LeftHand", Some(11), [0.0, -0.25, 0.0]),
-                j("RightArm", Some(7), [-0.18, 0.3, 0.0]),
-                j("RightForeArm", Some(13), [0.0, -0.28, 0.0]),
-                j("RightHand", Some(14), [0.0, -0.25, 0.0]),
-            ],
-        };
-        let frames = bends
-            .iter()
-            .map(|&b| {
-                let mut p = Pose::rest(&skeleton);
-                p.rotations[7] = Quat::from_rotation_x(b);
-                p
-            })
-            .collect();
-        Clip {
-            name: "torso".into(),
-            skeleton,
-            frame_time: 1.0 / 30.0,
-            frames,
-        }
+        crate::anim::check::tests::figure(bends.len(), |f, p| {
+            p.rotations[crate::anim::check::tests::SPINE] = Quat::from_rotation_x(bends[f]);
+        })
     }
 
     #[test]
