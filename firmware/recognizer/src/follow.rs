@@ -78,7 +78,8 @@ pub(crate) enum Follow {
     New,
 }
 
-/// What match `c` is to the held event `h` (see the module docs).
+/// What match `c` is to the held event `h` (see the module docs); `late`: a stillness longer
+/// than [`CONTINUE_US`] lies between them.
 // Out of line: commits only, and for flash. One pass over the runs from `h`'s start to `c`'s
 // end gathers all it needs.
 #[inline(never)]

@@ -552,10 +552,11 @@ impl<'lib> Recognizer<'lib> {
         // Past the usual pause, only the rest of a hold its action's examples made (a crouch
         // held low, then risen from) continues it.
         let hist = self.front.history();
-        let late = (1..c.start.wrapping_sub(h.end_run))
-            .take(HISTORY_RUNS)
-            .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
-            .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
+        let gap = c.start.wrapping_sub(h.end_run);
+        let late = gap <= HISTORY_RUNS as u32
+            && (1..gap)
+                .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
+                .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
         match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
             Follow::Settles => return None,
