@@ -421,15 +421,9 @@ impl Detector {
     /// its edges span enough pixels to be fitted. Four times the pixels: a few milliseconds
     /// for a region around one small tag.
     pub fn detect_in_enlarged(&mut self, frame: &GrayFrame, region: Region) -> Vec<Detection> {
-        if frame.width == 0 || frame.height == 0 || frame.pixels.len() < frame.width * frame.height
-        {
+        let Some((x0, x1, y0, y1)) = clipped(frame, region) else {
             return Vec::new();
-        }
-        let (x0, x1) = (region.x0.min(frame.width), region.x1.min(frame.width));
-        let (y0, y1) = (region.y0.min(frame.height), region.y1.min(frame.height));
-        if x1 < x0 + 8 || y1 < y0 + 8 {
-            return Vec::new();
-        }
+        };
         let (w, h) = ((x1 - x0) * ENLARGE, (y1 - y0) * ENLARGE);
         let at = |x: usize, y: usize| frame.pixels[y * frame.width + x] as f32;
         self.scratch.clear();
@@ -471,15 +465,9 @@ impl Detector {
         region: Region,
         blur: [f64; 2],
     ) -> Vec<Detection> {
-        if frame.width == 0 || frame.height == 0 || frame.pixels.len() < frame.width * frame.height
-        {
+        let Some((x0, x1, y0, y1)) = clipped(frame, region) else {
             return Vec::new();
-        }
-        let (x0, x1) = (region.x0.min(frame.width), region.x1.min(frame.width));
-        let (y0, y1) = (region.y0.min(frame.height), region.y1.min(frame.height));
-        if x1 < x0 + 8 || y1 < y0 + 8 {
-            return Vec::new();
-        }
+        };
         let (w, h) = (x1 - x0, y1 - y0);
         self.scratch.clear();
         for y in y0..y1 {
@@ -560,6 +548,17 @@ impl Drop for Detector {
         // SAFETY: created in `new`, destroyed once, before `table` (dropped after this body).
         unsafe { sys::apriltag_detector_destroy(self.det) }
     }
+}
+
+/// `region` clipped to `frame` as (x0, x1, y0, y1), pixels; None for a frame whose pixels do
+/// not fill it, or a region under 8 pixels a side once clipped (nothing to segment).
+fn clipped(frame: &GrayFrame, region: Region) -> Option<(usize, usize, usize, usize)> {
+    if frame.width == 0 || frame.height == 0 || frame.pixels.len() < frame.width * frame.height {
+        return None;
+    }
+    let (x0, x1) = (region.x0.min(frame.width), region.x1.min(frame.width));
+    let (y0, y1) = (region.y0.min(frame.height), region.y1.min(frame.height));
+    (x1 >= x0 + 8 && y1 >= y0 + 8).then_some((x0, x1, y0, y1))
 }
 
 #[cfg(test)]
