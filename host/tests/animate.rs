@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use figurine_host::anim::assemble::{assemble, AssembleOptions, Assembly};
+use figurine_host::anim::assemble::{assemble, AssembleOptions, Assembly, LIMB_SWING_JOINTS};
 use figurine_host::anim::effort::spine_lean;
 use figurine_host::anim::joint_limits::JointRanges;
 use figurine_host::anim::library::ClipLibrary;
@@ -384,19 +384,7 @@ fn strong_moves_wider_and_bends_lower_than_light() {
     }
 }
 
-/// The joints [`Assembly::limb_swing_rad`] averages.
-const LIMB_JOINTS: [&str; 8] = [
-    "right_shoulder",
-    "right_elbow",
-    "left_shoulder",
-    "left_elbow",
-    "right_hip",
-    "right_knee",
-    "left_hip",
-    "left_knee",
-];
-
-/// Per joint of [`LIMB_JOINTS`]: its mean swing (rad) from the action's first frame over the
+/// Per joint of [`LIMB_SWING_JOINTS`]: its mean swing (rad) from the action's first frame over the
 /// action, and the share of the action's frames in which swinging it 10 % further from that
 /// pose would leave the range the library's actors moved it in (it is at its range's edge).
 fn swing_by_joint(a: &Assembly, ranges: &JointRanges) -> Vec<(&'static str, f32, f32)> {
@@ -404,7 +392,7 @@ fn swing_by_joint(a: &Assembly, ranges: &JointRanges) -> Vec<(&'static str, f32,
     let p = &a.placements[0];
     let frames = &a.clip.frames[p.start_frame..=p.end_frame];
     let q0 = &a.clip.frames[p.start_frame].rotations;
-    LIMB_JOINTS
+    LIMB_SWING_JOINTS
         .iter()
         .filter_map(|&n| Some((n, sk.find(n)?)))
         .map(|(n, j)| {

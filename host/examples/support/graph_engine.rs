@@ -13,7 +13,7 @@
 //! allocation and end, each task's allocation and completion, the merge's), so that where the
 //! time goes is measured, not guessed. With several runs, the medians follow. The scale model
 //! uses CPU time per window pair divided by the cores of a task.
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
@@ -210,20 +210,26 @@ fn engine_run(
     })
 }
 
-/// Runs the comparison for each band of `bands` (frames), `runs` times over (each time
-/// `graph build` first, then every band, so each run's overhead compares like conditions),
-/// and prints every figure, then the medians; with `model_too`, also the scale model for 4 M
-/// frames from the last band's runs.
-pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -> Result<()> {
-    let n: usize = clips.iter().map(|c| c.len()).sum();
-    let exe = std::env::current_exe()?
+/// The release `figurine` binary beside the examples folder, which the benches run as a user
+/// would.
+pub fn figurine_exe() -> Result<PathBuf> {
+    std::env::current_exe()?
         .parent()
         .and_then(Path::parent)
         .map(|d| d.join("figurine"))
         .filter(|p| p.is_file())
         .context(
             "no release figurine binary: cargo build --release -p figurine-host --bin figurine",
-        )?;
+        )
+}
+
+/// Runs the comparison for each band of `bands` (frames), `runs` times over (each time
+/// `graph build` first, then every band, so each run's overhead compares like conditions),
+/// and prints every figure, then the medians; with `model_too`, also the scale model for 4 M
+/// frames from the last band's runs.
+pub fn run(clips: &[GraphClip], bands: &[usize], runs: usize, model_too: bool) -> Result<()> {
+    let n: usize = clips.iter().map(|c| c.len()).sum();
+    let exe = figurine_exe()?;
     let dir = std::env::temp_dir().join(format!("figurine-graph-engine-{}", std::process::id()));
     // The library as BVH files, so that `graph build` and `graph plan` read the same clips the
     // way a user's commands would.

@@ -17,7 +17,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use figurine_host::graph::plan::{plan_job, DEFAULT_BAND};
 use figurine_host::graph::tile::run_tile;
 use figurine_host::graph::{build_graph, BuildParams, GraphClip};
@@ -107,14 +107,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// Plans, tiles and merges each library of `libraries` (`runs` merges each) and prints one row
 /// per library.
 pub fn run(libraries: &[Vec<GraphClip>], runs: usize) -> Result<()> {
-    let exe = std::env::current_exe()?
-        .parent()
-        .and_then(Path::parent)
-        .map(|d| d.join("figurine"))
-        .filter(|p| p.is_file())
-        .context(
-            "no release figurine binary: cargo build --release -p figurine-host --bin figurine",
-        )?;
+    let exe = crate::engine::figurine_exe()?;
     let has_strace = Command::new("strace").arg("-V").output().is_ok();
     let dir = std::env::temp_dir().join(format!("figurine-merge-bench-{}", std::process::id()));
     println!(

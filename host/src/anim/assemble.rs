@@ -174,6 +174,18 @@ pub struct Assembly {
     pub t_origin: f64,
 }
 
+/// The arms' and legs' joints whose swing [`Assembly::limb_swing_rad`] averages.
+pub const LIMB_SWING_JOINTS: [&str; 8] = [
+    "right_shoulder",
+    "right_elbow",
+    "left_shoulder",
+    "left_elbow",
+    "right_hip",
+    "right_knee",
+    "left_hip",
+    "left_knee",
+];
+
 impl Assembly {
     /// How far an event's limbs swing (rad): the mean angle by which the arms' and legs' joints
     /// turn away from their pose at the event's first frame, over its frames — what effort's
@@ -181,19 +193,10 @@ impl Assembly {
     /// without such a placement.
     pub fn limb_swing_rad(&self, placement: usize) -> Option<f32> {
         let sk = &self.clip.skeleton;
-        let joints: Vec<usize> = [
-            "right_shoulder",
-            "right_elbow",
-            "left_shoulder",
-            "left_elbow",
-            "right_hip",
-            "right_knee",
-            "left_hip",
-            "left_knee",
-        ]
-        .iter()
-        .filter_map(|n| sk.find(n))
-        .collect();
+        let joints: Vec<usize> = LIMB_SWING_JOINTS
+            .iter()
+            .filter_map(|n| sk.find(n))
+            .collect();
         let p = self.placements.get(placement)?;
         let q0 = &self.clip.frames.get(p.start_frame)?.rotations;
         let frames = self.clip.frames.get(p.start_frame..=p.end_frame)?;

@@ -403,11 +403,7 @@ impl Detector {
         let (w, h) = (x1 - x0, y1 - y0);
         // The library takes a mutable pointer; it only reads, but a private copy keeps the
         // caller's buffer out of C's hands altogether (≈ 0.02 ms at 640×480).
-        self.scratch.clear();
-        for y in y0..y1 {
-            self.scratch
-                .extend_from_slice(&frame.pixels[y * frame.width + x0..y * frame.width + x1]);
-        }
+        self.copy_to_scratch(frame, x0, x1, y0, y1);
         let whole = w == frame.width && h == frame.height;
         self.run_scratch(w, h, whole)
             .into_iter()
@@ -469,17 +465,23 @@ impl Detector {
             return Vec::new();
         };
         let (w, h) = (x1 - x0, y1 - y0);
-        self.scratch.clear();
-        for y in y0..y1 {
-            self.scratch
-                .extend_from_slice(&frame.pixels[y * frame.width + x0..y * frame.width + x1]);
-        }
+        self.copy_to_scratch(frame, x0, x1, y0, y1);
         self.scratch =
             super::deblur::deblur_line(&self.scratch, w, h, blur, super::deblur::ITERATIONS);
         self.run_scratch(w, h, false)
             .into_iter()
             .map(|d| d.moved(|[x, y]| [x + x0 as f64, y + y0 as f64]))
             .collect()
+    }
+
+    /// Copies the pixels of `frame` in columns `x0..x1`, rows `y0..y1` (already clipped) into
+    /// the scratch buffer, row by row.
+    fn copy_to_scratch(&mut self, frame: &GrayFrame, x0: usize, x1: usize, y0: usize, y1: usize) {
+        self.scratch.clear();
+        for y in y0..y1 {
+            self.scratch
+                .extend_from_slice(&frame.pixels[y * frame.width + x0..y * frame.width + x1]);
+        }
     }
 
     /// Runs the library on the `w`×`h` image in `scratch` (with every thread when it is a
