@@ -40,6 +40,8 @@ pub struct Frontend {
     cand: Accum,
     cand_start: (u32, u64),
     cand_end: (u32, u64),
+    /// The first and last quiet ticks among the candidate's.
+    cand_quiet: Option<((u32, u64), (u32, u64))>,
     ticks: u32,
     last_tick_us: u64,
 }
@@ -56,6 +58,7 @@ impl Frontend {
             cand: Accum::new(),
             cand_start: (0, 0),
             cand_end: (0, 0),
+            cand_quiet: None,
             ticks: 0,
             last_tick_us: 0,
         }
@@ -101,8 +104,12 @@ impl Frontend {
             let at = (k.tick.seq, k.tick.sample_t_us);
             self.ticks = self.ticks.saturating_add(1);
             self.last_tick_us = k.tick.t_us;
-            match self.tokenizer.step(&k) {
-                TokenStep::Run => self.extend_current(&q, rise, &k, at),
+            let step = self.tokenizer.step(&k);
+            // Only a tick that may belong to a STILL run is checked (none of a moving run's).
+            let may_rest = self.tokenizer.current() == Some(STILL) || step != TokenStep::Run;
+            let quiet = may_rest && self.tokenizer.quiet(&k);
+            match step {
+                TokenStep::Run => self.extend_current(&q, rise, &k, at, quiet),
                 TokenStep::Candidate => {
                     if self.cand.n == 0 {
                         self.cand_start = at;
@@ -110,26 +117,34 @@ impl Frontend {
                     self.cand_end = at;
                     self.cand.add(&q, rise);
                     self.cand.travel(k.world_v, k.w);
+                    self.note_cand_quiet(at, quiet);
                 }
                 TokenStep::BlipMerged { starts_candidate } => {
                     let blip = core::mem::take(&mut self.cand);
                     let blip_end = self.cand_end;
+                    let blip_quiet = self.cand_quiet.take();
                     if let Some(r) = self.history.newest_mut() {
                         r.acc.merge(&blip);
                         r.end = blip_end;
+                        if let (STILL, Some((first, last))) = (r.token, blip_quiet) {
+                            r.mark_quiet(first);
+                            r.mark_quiet(last);
+                        }
                     }
                     if starts_candidate {
                         self.cand_start = at;
                         self.cand_end = at;
                         self.cand.add(&q, rise);
                         self.cand.travel(k.world_v, k.w);
+                        self.note_cand_quiet(at, quiet);
                     } else {
-                        self.extend_current(&q, rise, &k, at);
+                        self.extend_current(&q, rise, &k, at, quiet);
                     }
                 }
                 TokenStep::NewToken { token } => {
                     let start = if self.cand.n > 0 { self.cand_start } else { at };
                     let mut acc = core::mem::take(&mut self.cand);
+                    let cand_quiet = self.cand_quiet.take();
                     acc.add(&q, rise);
                     if token != STILL {
                         acc.travel(k.world_v, k.w);
@@ -137,6 +152,15 @@ impl Frontend {
                     let index = self.history.open(token, start, acc);
                     if let Some(r) = self.history.newest_mut() {
                         r.end = at;
+                        if token == STILL {
+                            if let Some((first, last)) = cand_quiet {
+                                r.mark_quiet(first);
+                                r.mark_quiet(last);
+                            }
+                            if quiet {
+                                r.mark_quiet(at);
+                            }
+                        }
                     }
                     on(self, FrontEvent::Opened { index, token });
                 }
@@ -150,13 +174,25 @@ impl Frontend {
         rise: f32,
         k: &Kinematics,
         at: (u32, u64),
+        quiet: bool,
     ) {
         if let Some(r) = self.history.newest_mut() {
             r.acc.add(q, rise);
             if r.token != STILL {
                 r.acc.travel(k.world_v, k.w);
+            } else if quiet {
+                r.mark_quiet(at);
             }
             r.end = at;
+        }
+    }
+
+    /// Notes a candidate tick `at`, quiet or not: the candidate's ticks may yet join a STILL
+    /// run.
+    fn note_cand_quiet(&mut self, at: (u32, u64), quiet: bool) {
+        if quiet {
+            let first = self.cand_quiet.map_or(at, |(f, _)| f);
+            self.cand_quiet = Some((first, at));
         }
     }
 
@@ -166,5 +202,6 @@ impl Frontend {
         self.tokenizer.restart();
         self.history.clear();
         self.cand = Accum::new();
+        self.cand_quiet = None;
     }
 }

@@ -5,6 +5,10 @@
 //! ([`crate::features::Accum`]). Runs are addressed by an absolute index that counts every run
 //! since the recognizer started (wrapping u32). A match reaching further back than the ring is
 //! clipped to the oldest run still held (documented truncation; patterns are ≤ 32 tokens).
+//! A STILL run also keeps where the figurine was truly at rest inside it
+//! ([`crate::noise::NoiseFloor::quiet`]): its first quiet tick, where the motion before it had
+//! settled, and its last, where the motion after it set off. An event is reported from the one
+//! to the other, so a slow onset or settle below the "moving" threshold is part of its span.
 //! RAM: `HISTORY_RUNS × 280` bytes ≈ 10.9 KiB.
 
 use crate::features::Accum;
@@ -24,6 +28,39 @@ pub struct Run {
     pub end: (u32, u64),
     /// Feature sums over the run's ticks.
     pub acc: Accum,
+    /// The first quiet tick, as an offset from `start` (see [`Quiet`]).
+    pub first_quiet: Quiet,
+    /// The last quiet tick, as an offset from `start`.
+    pub last_quiet: Quiet,
+}
+
+/// A tick inside a run as its offset from the run's first tick, in input samples;
+/// [`Quiet::NONE`] when there is none, or it lies further from the start than the offset
+/// reaches (65,534 samples: a rest of over a minute at 1 kHz reports the event from its
+/// first moving run). Two bytes, so that a run takes no more room than without them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Quiet(u16);
+
+impl Quiet {
+    /// No such tick.
+    pub const NONE: Quiet = Quiet(u16::MAX);
+
+    /// Tick `at` (seq, µs) of a run that began at `start`; NONE past the offset's reach.
+    fn of(start: (u32, u64), at: (u32, u64)) -> Quiet {
+        Quiet(u16::try_from(at.0.wrapping_sub(start.0)).unwrap_or(u16::MAX))
+    }
+
+    /// The tick (seq, µs) in a run from `start` to `end`. Its time is interpolated between
+    /// theirs by sample count: exact for a steady tracker, within its jitter otherwise.
+    fn at(self, start: (u32, u64), end: (u32, u64)) -> Option<(u32, u64)> {
+        if self == Quiet::NONE {
+            return None;
+        }
+        let k = u64::from(self.0);
+        let n = u64::from(end.0.wrapping_sub(start.0)).max(k).max(1);
+        let t = start.1 + end.1.saturating_sub(start.1) * k / n;
+        Some((start.0.wrapping_add(u32::from(self.0)), t))
+    }
 }
 
 impl Run {
@@ -32,7 +69,28 @@ impl Run {
         start: (0, 0),
         end: (0, 0),
         acc: Accum::new(),
+        first_quiet: Quiet::NONE,
+        last_quiet: Quiet::NONE,
     };
+
+    /// Records a quiet tick `at` (seq, µs) of this run.
+    pub fn mark_quiet(&mut self, at: (u32, u64)) {
+        let q = Quiet::of(self.start, at);
+        if self.first_quiet == Quiet::NONE {
+            self.first_quiet = q;
+        }
+        self.last_quiet = q;
+    }
+
+    /// The first quiet tick (seq, µs): where the motion before this rest had settled.
+    pub fn settled(&self) -> Option<(u32, u64)> {
+        self.first_quiet.at(self.start, self.end)
+    }
+
+    /// The last quiet tick (seq, µs): where the motion after this rest set off.
+    pub fn set_off(&self) -> Option<(u32, u64)> {
+        self.last_quiet.at(self.start, self.end)
+    }
 }
 
 /// Ring of recent runs.
@@ -75,6 +133,8 @@ impl History {
                 start,
                 end: start,
                 acc,
+                first_quiet: Quiet::NONE,
+                last_quiet: Quiet::NONE,
             };
         }
         self.next = self.next.wrapping_add(1);
@@ -161,5 +221,24 @@ mod tests {
         assert_eq!(h.accum(98, 99).n, 3);
         h.clear();
         assert!(h.get(99).is_none());
+    }
+
+    #[test]
+    fn a_run_keeps_its_first_and_last_quiet_ticks() {
+        let mut h = History::new();
+        h.open(STILL, (1_000, 5_000_000), Accum::new());
+        let r = h.newest_mut().unwrap();
+        assert_eq!((r.settled(), r.set_off()), (None, None));
+        r.end = (1_010, 5_100_000);
+        r.mark_quiet((1_003, 5_030_000));
+        r.mark_quiet((1_009, 5_090_000));
+        assert_eq!(r.settled(), Some((1_003, 5_030_000)));
+        assert_eq!(r.set_off(), Some((1_009, 5_090_000)));
+        // Past the offset's reach (over a minute into the rest at 1 kHz): none, never a
+        // wrong tick.
+        r.end = (71_000, 75_000_000);
+        r.mark_quiet((70_000, 74_000_000));
+        assert_eq!(r.set_off(), None);
+        assert_eq!(r.settled(), Some((1_003, 5_003_000)));
     }
 }

@@ -50,6 +50,12 @@ pub const ISOTROPIC_SHARE: f32 = 0.1;
 pub const ON_FACTOR: f32 = 2.5;
 /// A moving vector rests again below this multiple of the noise rms.
 pub const OFF_FACTOR: f32 = 1.5;
+/// A vector is at rest (quiet) within this multiple of the noise rms: where an event's span
+/// begins and ends ([`crate::history::Run::settled`]).
+pub const QUIET_FACTOR: f32 = 1.0;
+/// Without any noise learnt (a noiseless tracker), a vector is quiet below this share of its
+/// floor.
+pub const NOISELESS_QUIET_SHARE: f32 = 1e-3;
 /// Time constant (s) of the slow mean velocity, which finds motion too slow to stand out of
 /// the noise tick by tick: averaging over τ cuts the derivative's noise by about τ / the
 /// filter's window, while a steady motion keeps its speed.
@@ -295,6 +301,18 @@ impl Channel {
         }
     }
 
+    /// Whether `v` lies within the noise: vᵀ C⁻¹ v < 3 × [`QUIET_FACTOR`]² (|v| below the
+    /// rms for noise alike on all axes).
+    fn quiet(&self, v: [f32; 3]) -> bool {
+        match &self.inverse {
+            Some(m) => quadratic(m, v) < 3.0 * QUIET_FACTOR * QUIET_FACTOR,
+            None => {
+                let least = NOISELESS_QUIET_SHARE * self.least;
+                fmath::dot3(v, v) < least * least
+            }
+        }
+    }
+
     /// The noise rms (same unit as the vector).
     fn rms(&self) -> f32 {
         fmath::sqrt(self.noise[0] + self.noise[1] + self.noise[2])
@@ -367,6 +385,14 @@ impl NoiseFloor {
         } else {
             Motion::Still
         }
+    }
+
+    /// Whether the figurine is at rest: world velocity `v` (m/s) and angular velocity `w`
+    /// (rad/s) both within their noise (see [`QUIET_FACTOR`]). Stricter than "not moving",
+    /// which the hysteresis holds down to [`OFF_FACTOR`]: a slow onset or settle is neither
+    /// moving nor quiet.
+    pub fn quiet(&self, v: [f32; 3], w: [f32; 3]) -> bool {
+        !self.primed || (self.lin.quiet(v) && self.ang.quiet(w))
     }
 
     /// The slow mean velocity: translation in the object frame (m/s), rotation (rad/s).

@@ -407,6 +407,12 @@ impl Tokenizer {
         token_from_signs(self.lin, self.ang)
     }
 
+    /// Whether tick `k` (already stepped) is quiet: the figurine at rest within the noise
+    /// ([`NoiseFloor::quiet`]).
+    pub fn quiet(&self, k: &Kinematics) -> bool {
+        self.floor.quiet(k.world_v, k.w)
+    }
+
     /// The token of the current run, if any.
     pub fn current(&self) -> Option<Token> {
         self.current
