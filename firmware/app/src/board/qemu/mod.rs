@@ -12,6 +12,8 @@ mod flash;
 mod uart;
 mod vectors;
 
+use core::sync::atomic::{AtomicU32, Ordering};
+
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 
@@ -33,21 +35,50 @@ const SYSTICK_RELOAD: u32 = 0x00FF_FFFF;
 /// Semihosting command-line buffer, bytes.
 const ARGS_BUF: usize = 256;
 
-/// Counts core clock cycles over an interval shorter than one SysTick wrap (0.67 s).
-/// Under `qemu-system-arm -icount shift=0` one instruction takes 1 ns of virtual time, so
-/// instructions = cycles × 40 exactly (25 MHz), and counts repeat run to run.
-pub struct Stopwatch(u32);
+/// Cycles spent in the UART's interrupt handlers since boot (wrapping): a stopwatch leaves
+/// them out, so that a sample's processing time does not depend on when the host's bytes
+/// happened to arrive.
+static HANDLER_CYCLES: AtomicU32 = AtomicU32::new(0);
+
+/// Counts core clock cycles over an interval shorter than one SysTick wrap (0.67 s), less
+/// those the UART's interrupt handlers took meanwhile ([`in_handler`]). Under
+/// `qemu-system-arm -icount shift=0` one instruction takes 1 ns of virtual time, so
+/// instructions = cycles × 40 exactly (25 MHz), and counts repeat run to run (up to the
+/// handlers' few instructions outside their own stopwatch).
+pub struct Stopwatch {
+    systick: u32,
+    handlers: u32,
+}
 
 impl Stopwatch {
     /// Starts counting.
     pub fn start() -> Self {
-        Stopwatch(SYST::get_current())
+        Stopwatch {
+            systick: SYST::get_current(),
+            handlers: HANDLER_CYCLES.load(Ordering::Relaxed),
+        }
     }
 
-    /// Cycles since `start`.
+    /// Cycles since `start`, less the interrupt handlers'.
     pub fn cycles(&self) -> u32 {
-        self.0.wrapping_sub(SYST::get_current()) & SYSTICK_RELOAD
+        let all = self.systick.wrapping_sub(SYST::get_current()) & SYSTICK_RELOAD;
+        let handlers = HANDLER_CYCLES
+            .load(Ordering::Relaxed)
+            .wrapping_sub(self.handlers);
+        all.saturating_sub(handlers)
     }
+}
+
+/// Runs interrupt handler body `f`, adding the cycles it takes to [`HANDLER_CYCLES`].
+fn in_handler(f: impl FnOnce()) {
+    let start = SYST::get_current();
+    f();
+    let took = start.wrapping_sub(SYST::get_current()) & SYSTICK_RELOAD;
+    // A handler does not nest with itself; the two UART handlers share one priority.
+    HANDLER_CYCLES.store(
+        HANDLER_CYCLES.load(Ordering::Relaxed).wrapping_add(took),
+        Ordering::Relaxed,
+    );
 }
 
 /// Reads the power-cut fault injection from the semihosting command line

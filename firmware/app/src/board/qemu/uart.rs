@@ -91,22 +91,26 @@ pub(super) fn init(nvic: &mut NVIC) -> (SerialRx, SerialTx) {
 
 /// UART0 RX interrupt handler.
 pub(super) extern "C" fn on_rx() {
-    write(INTCLEAR, INT_RX);
-    while read(STATE) & STATE_RX_FULL != 0 {
-        if RX_PIPE.free_capacity() == 0 {
-            modify_ctrl(0, CTRL_RX_IE);
-            return;
+    super::in_handler(|| {
+        write(INTCLEAR, INT_RX);
+        while read(STATE) & STATE_RX_FULL != 0 {
+            if RX_PIPE.free_capacity() == 0 {
+                modify_ctrl(0, CTRL_RX_IE);
+                return;
+            }
+            let byte = read(DATA) as u8;
+            let _ = RX_PIPE.try_write(&[byte]);
         }
-        let byte = read(DATA) as u8;
-        let _ = RX_PIPE.try_write(&[byte]);
-    }
+    });
 }
 
 /// UART0 TX interrupt handler.
 pub(super) extern "C" fn on_tx() {
-    write(INTCLEAR, INT_TX);
-    modify_ctrl(0, CTRL_TX_IE);
-    TX_WAKER.wake();
+    super::in_handler(|| {
+        write(INTCLEAR, INT_TX);
+        modify_ctrl(0, CTRL_TX_IE);
+        TX_WAKER.wake();
+    });
 }
 
 /// Receive half of UART0.
