@@ -200,17 +200,24 @@ impl LeadingColumns {
     fn body_prefix(&self, meta: &[u8], body_len: u64) -> Result<u64, GraphError> {
         let batch = record_batch(meta, &self.path)?;
         let buffers = batch.buffers().map(|b| b.iter().collect::<Vec<_>>());
+        // Every buffer the message names must lie inside its body: the IPC decoder slices
+        // them unchecked, and a corrupt offset would panic there.
+        let stop = |buf: &arrow_ipc::Buffer| {
+            u64::try_from(buf.offset())
+                .ok()
+                .zip(u64::try_from(buf.length()).ok())
+                .and_then(|(o, l)| o.checked_add(l))
+                .filter(|&s| s <= body_len)
+                .ok_or_else(|| err(&self.path, "a column buffer lies outside its batch"))
+        };
+        for buf in buffers.iter().flatten() {
+            stop(buf)?;
+        }
         match buffers {
             Some(b) if batch.compression().is_none() && b.len() == self.all_buffers => {
                 let mut end = 0u64;
                 for buf in &b[..self.leading_buffers] {
-                    let stop = u64::try_from(buf.offset())
-                        .ok()
-                        .zip(u64::try_from(buf.length()).ok())
-                        .and_then(|(o, l)| o.checked_add(l))
-                        .filter(|&s| s <= body_len)
-                        .ok_or_else(|| err(&self.path, "a column buffer lies outside its batch"))?;
-                    end = end.max(stop);
+                    end = end.max(stop(buf)?);
                 }
                 Ok(end)
             }
