@@ -234,6 +234,12 @@ impl<'lib> Recognizer<'lib> {
                         })
                         .unwrap_or(c);
                     self.commit(c, &mut emit);
+                    // What moved after it while it was held (a turn begun while a run's match
+                    // waited for its next stride; a crouch right after a wave's last stroke) is
+                    // read afresh, as after a commit at a token, and the pause is weighed again
+                    // for what is pending now.
+                    self.hold = None;
+                    self.feed_from(self.floor, &mut emit);
                 } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
                     // Held for a longer action that may yet take it over, or for the next
                     // cycle of a cyclic one: reported after the usual pause (weighed once per
