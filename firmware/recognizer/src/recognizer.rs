@@ -236,9 +236,7 @@ impl<'lib> Recognizer<'lib> {
                     self.commit(c, &mut emit);
                     // What moved after it while it was held (a turn begun while a run's match
                     // waited for its next stride; a crouch right after a wave's last stroke) is
-                    // read afresh, as after a commit at a token, and the pause is weighed again
-                    // for what is pending now.
-                    self.hold = None;
+                    // read afresh, as after a commit at a token.
                     self.feed_from(self.floor, &mut emit);
                 } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
                     // Held for a longer action that may yet take it over, or for the next
@@ -667,6 +665,9 @@ impl<'lib> Recognizer<'lib> {
         let out = self.outcome(&c, before);
         self.bank.reset();
         self.decider.clear();
+        // The pause's answer was about the match now committed: what is pending next is
+        // weighed afresh.
+        self.hold = None;
         self.floor = c.end.wrapping_add(1);
         // Its runs are consumed either way; a too-brief one is not emitted (and a report of
         // another candidate stands).
