@@ -543,6 +543,7 @@ mod tests {
             world_v: v,
             world_a: a,
             world_j: j,
+            moving: Default::default(),
         }
     }
 
