@@ -4,10 +4,9 @@
 //! worst along the camera's line of sight), at 30–1000 Hz, and a hand adds tremor.
 //! Differentiated by the filter (its least-squares slope, [`crate::frame::Moving`]), that
 //! jitter becomes a velocity that a fixed floor either ignores (the noisy tracker fires at
-//! rest) or over-cuts (the quiet tracker loses small doodles). So each vector (world
-//! translation, object rotation) is judged against its own noise, learnt in the manner of
-//! minimum statistics (Martin 2001) and of a voice-activity detector's noise model (updated
-//! only from frames that are not speech):
+//! rest) or over-cuts (the quiet tracker loses small doodles). So each vector (world translation, object rotation) is judged
+//! against its own noise, learnt in the manner of minimum statistics (Martin 2001) and of a
+//! voice-activity detector's noise model (updated only from frames that are not speech):
 //!
 //! | step | what | why |
 //! |---|---|---|
@@ -247,7 +246,6 @@ impl Channel {
             // slopes to tell three axes apart, six together do; a stray counted block of a
             // gesture tilts it by one sixth at most, whatever its power.
             let mut shape = [0.0f32; 6];
-            let mut shapes = 0u8;
             for i in order.iter().take(known) {
                 let Some(c) = self.recent.get(*i) else {
                     continue;
@@ -257,11 +255,10 @@ impl Channel {
                     for (s, x) in shape.iter_mut().zip(c) {
                         *s += x / t;
                     }
-                    shapes += 1;
                 }
             }
-            let scale = if shapes > 0 && fmath::is_finite(median_power) {
-                median_power / f32::from(shapes)
+            let scale = if known > 0 && fmath::is_finite(median_power) {
+                median_power / known as f32
             } else {
                 0.0
             };
