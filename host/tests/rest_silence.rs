@@ -54,14 +54,13 @@ fn rest_under_every_tracker_gives_no_event() {
     assert!(fidgets >= TRACKER_LEVELS.len(), "{fidgets} fidgets");
 }
 
-/// Hand rests on which the shipped library without its learnt extents reads a fidget as an
-/// action (`figurine synth rest --seed S --seconds 300 --kind hand --tracker T`, simulated
-/// with the library's `extent`s set to null, over seeds 1–60): the rest's seed, its tracker,
+/// Hand rests on which the shipped library, before it learnt how far its examples went,
+/// read a fidget as an action (`figurine eval rest --verbose`): the rest's seed, its tracker,
 /// when the fidget's event began (s), and the action it was read as.
 const FIDGETS_ONCE_READ: [(u64, &str, f64, &str); 3] = [
-    (1, "lighthouse", 198.05, "sidestep"),
-    (46, "lighthouse", 283.84, "turn"),
-    (53, "lighthouse", 11.35, "bow"),
+    (6_854_274_470_864_460_927, "lighthouse", 22.44, "turn"),
+    (16_958_851_266_643_440_245, "lighthouse", 121.04, "bow"),
+    (2_724_813_854_111_988_808, "imu-fusion", 115.41, "wave"),
 ];
 
 /// The shipped library's actions as they are, and without their learnt extents.

@@ -543,7 +543,6 @@ mod tests {
             world_v: v,
             world_a: a,
             world_j: j,
-            moving: Default::default(),
         }
     }
 

@@ -5,17 +5,6 @@
 //! velocity, acceleration and jerk of every channel (3 position + 4 quaternion components).
 //! Added latency: [`SG_HALF`] ticks = 50 ms. The coefficients are computed at compile time.
 //! RAM: `SG_WINDOW × (7 f32 + 2 u64 + u32)` ≈ 0.5 KiB.
-//!
-//! The same window also gives each channel's least-squares *slope* (a first-order fit):
-//!
-//! | velocity | white-noise gain (per tick, 11 ticks) | passband | used for |
-//! |---|---|---|---|
-//! | cubic fit, `d[1]` | 0.246 | ≈ 13 Hz | effort: how a stroke starts and stops |
-//! | slope, `slope` | 0.095 | ≈ 6.5 Hz | whether and where the figurine moves (tokens) |
-//!
-//! A stroke is slower than 6.5 Hz, so the slope keeps its direction while the tracker's
-//! jitter, which the cubic fit passes up to 13 Hz, is cut 2.6-fold: a small, slow or noisy
-//! doodle stands out of the noise, and a hop's way down is not lost in it.
 
 use crate::intake::{Tick, TICK_S};
 
@@ -100,21 +89,6 @@ const fn sg_coefficients() -> [[f64; SG_WINDOW]; 4] {
     out
 }
 
-/// Slope coefficients scaled by the tick period, f32: x / Σx² / dt for offsets x of the window.
-const SLOPE: [f32; SG_WINDOW] = slope();
-
-const fn slope() -> [f32; SG_WINDOW] {
-    let h = SG_HALF as f64;
-    let sum_sq = h * (h + 1.0) * (2.0 * h + 1.0) / 3.0;
-    let mut out = [0.0f32; SG_WINDOW];
-    let mut i = 0;
-    while i < SG_WINDOW {
-        out[i] = ((i as f64 - h) / sum_sq / TICK_S as f64) as f32;
-        i += 1;
-    }
-    out
-}
-
 /// Per-tick coefficients scaled by the tick period, f32 (`[order][offset]`).
 const SCALED: [[f32; SG_WINDOW]; 4] = scaled();
 
@@ -141,9 +115,6 @@ pub struct Smoothed {
     pub tick: Tick,
     /// `[order][channel]`: value, d/dt, d²/dt², d³/dt³ (units of the channel per sᵏ).
     pub d: [[f32; CHANNELS]; 4],
-    /// Per channel: the window's least-squares slope, a d/dt with less noise and half the
-    /// passband of `d[1]` (units of the channel per s).
-    pub slope: [f32; CHANNELS],
 }
 
 /// Streaming Savitzky–Golay filter over a ring of the last [`SG_WINDOW`] ticks.
@@ -188,7 +159,6 @@ impl SavGol {
             return None;
         }
         let mut d = [[0.0f32; CHANNELS]; 4];
-        let mut slope = [0.0f32; CHANNELS];
         let mut centre = None;
         #[allow(clippy::needless_range_loop)] // k also picks the ring slot
         for k in 0..SG_WINDOW {
@@ -208,12 +178,8 @@ impl SavGol {
                     *acc += c * v;
                 }
             }
-            let c = SLOPE.get(k).copied().unwrap_or(0.0);
-            for (acc, v) in slope.iter_mut().zip(ch) {
-                *acc += c * v;
-            }
         }
-        centre.map(|tick| Smoothed { tick, d, slope })
+        centre.map(|tick| Smoothed { tick, d })
     }
 }
 
@@ -254,29 +220,6 @@ mod tests {
         assert!((o.d[3][0] - 24.0).abs() < 2.0, "{}", o.d[3][0]);
         // Constant channels have zero derivatives.
         assert!(o.d[1][3].abs() < 1e-3);
-    }
-
-    #[test]
-    fn the_slope_is_a_lines_and_carries_less_jitter_than_the_cubics_derivative() {
-        let mut sg = SavGol::new();
-        let mut last = None;
-        for i in 0..20u64 {
-            if let Some(o) = sg.push(tick(i, 0.3 - 1.7 * i as f32 * TICK_S)) {
-                last = Some(o);
-            }
-        }
-        let o = last.unwrap();
-        assert!((o.slope[0] + 1.7).abs() < 1e-3, "{}", o.slope[0]);
-        assert!(o.slope[3].abs() < 1e-3);
-        // White jitter's gain is the root sum of squares of the coefficients: 0.095 against
-        // 0.246 per tick (in units of 1/dt) over 11 ticks.
-        let gain = |c: &[f32]| c.iter().map(|x| x * x).sum::<f32>().sqrt() * TICK_S;
-        assert!((gain(&SLOPE) - 0.0953).abs() < 1e-3, "{}", gain(&SLOPE));
-        assert!(
-            (gain(&SCALED[1]) - 0.2457).abs() < 1e-3,
-            "{}",
-            gain(&SCALED[1])
-        );
     }
 
     #[test]

@@ -34,21 +34,6 @@ pub struct Kinematics {
     pub world_a: [f32; 3],
     /// World jerk, m/s³.
     pub world_j: [f32; 3],
-    /// The moving velocities, from the filter's slope (less noise, half the passband; see
-    /// [`crate::filter`]): whether and where the figurine moves.
-    pub moving: Moving,
-}
-
-/// Velocities from the filter's least-squares slope: what tells motion from rest, and its
-/// direction ([`crate::token`]).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Moving {
-    /// Linear velocity in the object frame, m/s.
-    pub v: [f32; 3],
-    /// Angular velocity in the object frame, rad/s.
-    pub w: [f32; 3],
-    /// World velocity, m/s.
-    pub world_v: [f32; 3],
 }
 
 fn vec_part(q: [f32; 4], s: f32) -> [f32; 3] {
@@ -78,12 +63,6 @@ pub fn kinematics(s: &Smoothed) -> Kinematics {
     let world_v = [s.d[1][0], s.d[1][1], s.d[1][2]];
     let world_a = [s.d[2][0], s.d[2][1], s.d[2][2]];
     let world_j = [s.d[3][0], s.d[3][1], s.d[3][2]];
-    let slope_world_v = [s.slope[0], s.slope[1], s.slope[2]];
-    let moving = Moving {
-        v: fmath::rotate_inv(qu, slope_world_v),
-        w: vec_part(fmath::qmul(qc, pick(&s.slope, 3)), inv_n2),
-        world_v: slope_world_v,
-    };
     Kinematics {
         tick: s.tick,
         v: fmath::rotate_inv(qu, world_v),
@@ -95,7 +74,6 @@ pub fn kinematics(s: &Smoothed) -> Kinematics {
         world_v,
         world_a,
         world_j,
-        moving,
     }
 }
 

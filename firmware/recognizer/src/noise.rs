@@ -2,9 +2,9 @@
 //!
 //! Trackers range from ~0.3 mm of jitter (Lighthouse) to several millimetres (a webcam tag,
 //! worst along the camera's line of sight), at 30–1000 Hz, and a hand adds tremor.
-//! Differentiated by the filter (its least-squares slope, [`crate::frame::Moving`]), that
-//! jitter becomes a velocity that a fixed floor either ignores (the noisy tracker fires at
-//! rest) or over-cuts (the quiet tracker loses small doodles). So each vector (world translation, object rotation) is judged
+//! Differentiated by the Savitzky–Golay filter, that jitter becomes a velocity that a fixed
+//! floor either ignores (the noisy tracker fires at rest) or over-cuts (the quiet tracker
+//! loses small doodles). So each vector (world translation, object rotation) is judged
 //! against its own noise, learnt in the manner of minimum statistics (Martin 2001) and of a
 //! voice-activity detector's noise model (updated only from frames that are not speech):
 //!
@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | 1 | ticks are grouped into blocks of [`BLOCK_TICKS`] (0.25 s); a block's power is its mean v vᵀ | a pause between strokes is a block of its own |
 //! | 2 | a block counts as noise only if both vectors went nowhere: \|Σv\| < [`COHERENCE_MAX`] × Σ\|v\| | jitter and tremor go to and fro, a stroke or a spin goes somewhere, whatever the tracker: a gesture is not learnt as noise |
-//! | 3 | the noise's power is the median block power among the last [`BLOCKS`] counted ones; its shape over the axes, the mean of those blocks' shapes (each scaled to unit power) | robust to a stray counted block of a gesture; less biased than the least block where a block holds few independent samples (30 Hz); one block holds too few independent velocities to tell three axes apart, and a shape learnt from one calls its quiet axis loud |
+//! | 3 | the noise is the counted block of median power among the last [`BLOCKS`] counted ones | robust to a stray counted block of a gesture; less biased than the least block where a block holds few independent samples (30 Hz) |
 //! | 4 | a vector starts moving when vᵀ C⁻¹ v ≥ 3 × [`ON_FACTOR`]² (\|v\| ≥ [`ON_FACTOR`] × rms for noise alike on all axes) and it heads somewhere (running mean velocity ≥ [`HEADING_SHARE`] × running mean speed); it stays moving down to [`OFF_FACTOR`] | two thresholds (hysteresis); a webcam's depth jitter needs more along the depth only |
 //! | 5 | failing that, the slow mean velocity (time constant [`SLOW_TAU_S`]) is judged alike against its own noise power (the mean over the counted blocks), while it is no faster than the vector is now | a sustained motion under heavy jitter stands out once averaged; a stroke that ended lingers in the mean, but the figurine no longer moves that fast |
 //!
@@ -240,37 +240,11 @@ impl Channel {
                 .filter(|&&i| fmath::is_finite(trace(i)))
                 .count();
             let rank = known.saturating_sub(1) / 2;
-            let median_power = order.get(rank).map_or(f32::INFINITY, |&i| trace(i));
-            // The noise's shape (how it spreads over the axes) is the mean of the counted
-            // blocks' shapes, each scaled to unit power: one block holds too few independent
-            // slopes to tell three axes apart, six together do; a stray counted block of a
-            // gesture tilts it by one sixth at most, whatever its power.
-            let mut shape = [0.0f32; 6];
-            for i in order.iter().take(known) {
-                let Some(c) = self.recent.get(*i) else {
-                    continue;
-                };
-                let t = trace(*i);
-                if t > 0.0 {
-                    for (s, x) in shape.iter_mut().zip(c) {
-                        *s += x / t;
-                    }
-                }
-            }
-            let scale = if known > 0 && fmath::is_finite(median_power) {
-                median_power / known as f32
-            } else {
-                0.0
-            };
-            let median = if scale > 0.0 {
-                shape.map(|s| s * scale)
-            } else {
-                order
-                    .get(rank)
-                    .and_then(|&i| self.recent.get(i))
-                    .copied()
-                    .unwrap_or(self.noise)
-            };
+            let median = order
+                .get(rank)
+                .and_then(|&i| self.recent.get(i))
+                .copied()
+                .unwrap_or(self.noise);
             // The slow mean holds about one independent value per block: a median of so few
             // would sit well below its mean power, so the mean over the counted blocks is taken.
             let counted_slow = self
@@ -587,46 +561,6 @@ mod tests {
                 "σ {sigma}: {moved} ticks, {longest} in a row"
             );
         }
-    }
-
-    #[test]
-    fn a_webcams_depth_jitter_is_learnt_as_depth_at_every_block() {
-        // A tag seen by a webcam at 1 m: 30 Hz, white jitter σ 1.5 mm across the view and 4 mm
-        // along it (world x here), through intake and filter. One block holds too few
-        // independent slopes to tell three axes apart; learnt from one block, the noise's
-        // shape swings from block to block, and its quiet axes call jitter motion.
-        let mut n = Noise(0x5eed);
-        let mut intake = crate::intake::Intake::new();
-        let mut filter = crate::filter::SavGol::new();
-        let mut f = NoiseFloor::new();
-        let mut least = f32::INFINITY;
-        for i in 0..30 * 60u32 {
-            let s = crate::intake::Sample {
-                seq: i,
-                t_us: u64::from(i) * 1_000_000 / 30,
-                pos: [
-                    0.004 * n.normal(),
-                    1.0 + 0.0015 * n.normal(),
-                    0.0015 * n.normal(),
-                ],
-                quat: [1.0, 0.0, 0.0, 0.0],
-            };
-            intake.push(&s);
-            while let Some(tick) = intake.next_tick() {
-                let Some(sm) = filter.push(tick) else {
-                    continue;
-                };
-                let k = crate::frame::kinematics(&sm).moving;
-                f.push(k.world_v, fmath::norm3(k.v), k.v, k.w, fmath::norm3(k.w));
-                if f.primed && f.ticks == 0 && tick.t_us > 3_000_000 {
-                    let c = f.lin.noise;
-                    least = least.min(c[0] / fmath::max(c[1], c[2]));
-                }
-            }
-        }
-        // The truth is (4 / 1.5)² ≈ 7.1 times the variance along x; learnt from one block at a
-        // time, the least ratio was 0.6 (x the quietest axis).
-        assert!(least > 1.5, "least learnt depth / across variance {least}");
     }
 
     #[test]

@@ -1167,9 +1167,8 @@ mod tests {
     fn a_sudden_turn_briefer_than_any_gesture_is_still_one() {
         let blob = seq_library(&[(&[".Yp"], 0)]);
         let lib = Library::from_bytes(&blob).unwrap();
-        // Two thirds of a right angle in 0.08 s: a flicker as far as brevity goes (its run,
-        // widened by the filter's window, stays under the shortest action) …
-        assert_eq!(run(&lib, &twists(1.0, 0.08, None)), []);
+        // Two thirds of a right angle in 0.12 s: a flicker as far as brevity goes …
+        assert_eq!(run(&lib, &quick_twist(1.0)), []);
         // … a half turn is a turn.
         let ev = run(&lib, &quick_twist(core::f32::consts::PI));
         assert_eq!(ev.len(), 1, "{ev:?}");

@@ -1,7 +1,6 @@
 //! Stage 3 — motion tokens: 27 translation bins × 27 rotation bins, plus STILL.
 //!
-//! Each of the 3 linear and 3 angular object-frame velocity components (the filter's slope,
-//! [`crate::frame::Moving`]: less jitter than the cubic fit's derivative) gets a sign in
+//! Each of the 3 linear and 3 angular object-frame velocity components gets a sign in
 //! {−, 0, +}. A component counts only when it carries a real share of its vector's norm
 //! (≥ [`DOM_ON`] to switch on, stays on down to [`DOM_OFF`]: hysteresis against flicker on bin
 //! borders), so direction bins depend on the direction of motion only — not on its size or
@@ -384,7 +383,6 @@ impl Tokenizer {
 
     /// The instantaneous (unsuppressed) token of a tick; updates the peak trackers.
     pub fn raw_token(&mut self, k: &Kinematics) -> Token {
-        let k = &k.moving;
         let vn = fmath::norm3(k.v);
         let wn = fmath::norm3(k.w);
         self.v_peak = fmath::max(vn, self.v_peak * PEAK_DECAY);
@@ -412,7 +410,7 @@ impl Tokenizer {
     /// Whether tick `k` (already stepped) is quiet: the figurine at rest within the noise
     /// ([`NoiseFloor::quiet`]).
     pub fn quiet(&self, k: &Kinematics) -> bool {
-        self.floor.quiet(k.moving.world_v, k.moving.w)
+        self.floor.quiet(k.world_v, k.w)
     }
 
     /// The token of the current run, if any.
@@ -542,7 +540,6 @@ mod tests {
             world_v: v,
             world_a: [0.0; 3],
             world_j: [0.0; 3],
-            moving: crate::frame::Moving { v, w, world_v: v },
         }
     }
 
