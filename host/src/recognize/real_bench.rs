@@ -137,6 +137,18 @@ pub fn take_doodle(t: &RealTake) -> Result<(Doodle, Labels)> {
     Ok((d, labels))
 }
 
+/// The seconds of the take used, when not all of it (" 32-48 s"), else "".
+fn window(t: &RealTake) -> String {
+    match (t.start, t.end) {
+        (None, None) => String::new(),
+        (s, e) => format!(
+            " {}-{} s",
+            s.map_or("start".into(), |s| s.to_string()),
+            e.map_or("end".into(), |e| e.to_string())
+        ),
+    }
+}
+
 /// Recognises every take with the library `names`/`blob`; `save` keeps the doodles.
 pub fn score_takes(
     takes: &[RealTake],
@@ -157,7 +169,7 @@ pub fn score_takes(
             let mut body = Vec::new();
             d.log.write(&mut body)?;
             text.push_str(&String::from_utf8_lossy(&body));
-            let stem = t.take.replace(['/', '.'], "_");
+            let stem = format!("{}{}", t.take, window(t)).replace(['/', '.', ' '], "_");
             std::fs::write(dir.join(format!("{stem}_{}.csv", t.joint)), text)?;
         }
         let sim = simulate_log(&d.log, names, blob, effort)?;
@@ -173,7 +185,7 @@ pub fn score_takes(
             }
         }
         out.push(TakeScore {
-            take: format!("{} ({})", t.take, t.joint),
+            take: format!("{}{} ({})", t.take, window(t), t.joint),
             labels: labels.into_iter().map(|(a, _)| a).collect(),
             events: sim.records.iter().map(|r| r.action.clone()).collect(),
             hits,
@@ -208,12 +220,12 @@ pub fn run(args: &RealBenchArgs) -> Result<()> {
         scores.len()
     );
     println!(
-        "{:<46} {:<18} {:<30} hits",
+        "{:<56} {:<24} {:<30} hits",
         "take (landmark)", "labels", "events"
     );
     for s in &scores {
         println!(
-            "{:<46} {:<18} {:<30} {}/{}",
+            "{:<56} {:<24} {:<30} {}/{}",
             s.take,
             s.labels.join(" "),
             if s.events.is_empty() {
@@ -248,6 +260,24 @@ mod tests {
             assert!(!t.note.is_empty(), "{}: say how it was cut", t.take);
             for l in &t.actions {
                 assert!(names.contains(&l.action), "{}: {}", t.take, l.action);
+            }
+        }
+    }
+
+    #[test]
+    fn every_label_lies_inside_its_takes_window() {
+        for t in real_takes().unwrap() {
+            let (lo, hi) = (t.start.unwrap_or(0.0), t.end.unwrap_or(f64::INFINITY));
+            assert!(lo < hi, "{}: window {lo}-{hi}", t.take);
+            for l in &t.actions {
+                if let Some((a, b)) = l.span {
+                    assert!(
+                        lo <= a && a < b && b <= hi,
+                        "{} {}: {a}-{b}",
+                        t.take,
+                        l.action
+                    );
+                }
             }
         }
     }
