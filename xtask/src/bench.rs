@@ -62,6 +62,8 @@ pub fn bench() -> Result<()> {
 
     step("recognition on real doodles (people's motion capture): figurine eval real");
     figurine(&["eval", "real"])?;
+    step("the same over 15 libraries learnt from the generator: figurine eval real --libraries 15");
+    figurine(&["eval", "real", "--libraries", "15"])?;
 
     step("one action played several times back to back: figurine eval repeat");
     figurine(&["eval", "repeat"])?;

@@ -15,7 +15,9 @@ use clap::Args;
 use serde::Deserialize;
 
 use super::doodle::{doodle, Doodle, DoodleSpec};
+use super::eval::learn_synth_library;
 use super::simulate::{load_effort, load_library, simulate_log};
+use crate::synth::Knobs;
 
 /// The labelled takes, compiled in.
 pub const REAL_TAKES_JSON: &str = include_str!("../../assets/real_takes.json");
@@ -78,6 +80,14 @@ pub struct RealBenchArgs {
     /// Also write each doodle here (one CSV per take, with its label lines).
     #[arg(long)]
     pub save: Option<PathBuf>,
+    /// Learn this many libraries from the generator instead, as the shipped one is learnt (3
+    /// examples per action, train seeds `--train-seed` on), and report over all of them: what
+    /// one library reads is partly the luck of its examples.
+    #[arg(long, conflicts_with_all = ["library", "save"])]
+    pub libraries: Option<u64>,
+    /// First train seed of `--libraries` (the shipped library's is 1).
+    #[arg(long, default_value_t = 1, requires = "libraries")]
+    pub train_seed: u64,
 }
 
 /// One take's outcome.
@@ -91,6 +101,8 @@ pub struct TakeScore {
     pub events: Vec<String>,
     /// Labels matched by an event.
     pub hits: usize,
+    /// Per label, whether an event matched it.
+    pub found: Vec<bool>,
 }
 
 /// Whether spans `a` and `b` (seconds) overlap by [`MIN_OVERLAP`] of the shorter.
@@ -174,21 +186,23 @@ pub fn score_takes(
         }
         let sim = simulate_log(&d.log, names, blob, effort)?;
         let mut used = vec![false; sim.records.len()];
-        let mut hits = 0;
+        let mut found = Vec::with_capacity(labels.len());
         for (action, span) in &labels {
             let hit = sim.records.iter().enumerate().position(|(i, r)| {
                 !used[i] && &r.action == action && overlaps((r.start, r.end), *span)
             });
             if let Some(i) = hit {
                 used[i] = true;
-                hits += 1;
             }
+            found.push(hit.is_some());
         }
+        let hits = found.iter().filter(|&&f| f).count();
         out.push(TakeScore {
             take: format!("{}{} ({})", t.take, window(t), t.joint),
             labels: labels.into_iter().map(|(a, _)| a).collect(),
             events: sim.records.iter().map(|r| r.action.clone()).collect(),
             hits,
+            found,
         });
     }
     Ok(out)
@@ -206,44 +220,104 @@ pub fn recall_precision(scores: &[TakeScore]) -> (f64, f64) {
 /// Runs `figurine eval real`.
 pub fn run(args: &RealBenchArgs) -> Result<()> {
     let takes = real_takes()?;
-    let (lib, blob) = load_library(args.library.as_deref())?;
     let effort = load_effort(None)?;
-    let scores = score_takes(
-        &takes,
-        &lib.names(),
-        &blob,
-        Some(effort),
-        args.save.as_deref(),
-    )?;
-    println!(
-        "Real doodles: {} takes of real motion capture, figurine at the body landmark named",
-        scores.len()
+    let runs = match args.libraries {
+        None => {
+            let (lib, blob) = load_library(args.library.as_deref())?;
+            vec![score_takes(
+                &takes,
+                &lib.names(),
+                &blob,
+                Some(effort),
+                args.save.as_deref(),
+            )?]
+        }
+        Some(n) => {
+            let mut runs = Vec::new();
+            for seed in args.train_seed..args.train_seed.saturating_add(n) {
+                eprintln!("learning a library at train seed {seed}…");
+                let mut lib = learn_synth_library(seed, 3, &Knobs::default())?;
+                runs.push(score_takes(
+                    &takes,
+                    &lib.names(),
+                    &lib.blob()?,
+                    Some(effort),
+                    None,
+                )?);
+            }
+            runs
+        }
+    };
+    print!("{}", report(&runs));
+    Ok(())
+}
+
+/// The table of `figurine eval real` over one library's scores or several's (one `runs`
+/// entry per library, takes in the same order): per take its labels, its events (their count
+/// over several libraries) and its hits, then recall per action and over all.
+pub fn report(runs: &[Vec<TakeScore>]) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let n = runs.len();
+    let Some(first) = runs.first() else {
+        return out;
+    };
+    let _ = writeln!(
+        out,
+        "Real doodles: {} takes of real motion capture, figurine at the body landmark named{}",
+        first.len(),
+        if n > 1 {
+            format!("; hits and events summed over {n} libraries")
+        } else {
+            String::new()
+        }
     );
-    println!(
+    let _ = writeln!(
+        out,
         "{:<56} {:<24} {:<30} hits",
         "take (landmark)", "labels", "events"
     );
-    for s in &scores {
-        println!(
-            "{:<56} {:<24} {:<30} {}/{}",
+    let mut per_action: std::collections::BTreeMap<&str, (usize, usize)> = Default::default();
+    for (i, s) in first.iter().enumerate() {
+        let of_take = runs.iter().filter_map(|r| r.get(i));
+        let (hits, events) = of_take
+            .clone()
+            .fold((0, 0), |(h, e), t| (h + t.hits, e + t.events.len()));
+        for t in of_take {
+            for (label, &f) in t.labels.iter().zip(&t.found) {
+                let e = per_action.entry(label.as_str()).or_default();
+                e.0 += usize::from(f);
+                e.1 += 1;
+            }
+        }
+        let events = match (n, s.events.is_empty()) {
+            (1, true) => "(none)".to_string(),
+            (1, false) => s.events.join(" "),
+            _ => format!("{events}"),
+        };
+        let _ = writeln!(
+            out,
+            "{:<56} {:<24} {:<30} {hits}/{}",
             s.take,
             s.labels.join(" "),
-            if s.events.is_empty() {
-                "(none)".to_string()
-            } else {
-                s.events.join(" ")
-            },
-            s.hits,
-            s.labels.len()
+            events,
+            s.labels.len() * n
         );
     }
-    let (recall, precision) = recall_precision(&scores);
-    println!(
+    let recall: Vec<String> = per_action
+        .iter()
+        .map(|(a, (h, l))| format!("{a} {h}/{l}"))
+        .collect();
+    let _ = writeln!(out, "found per action: {}", recall.join(", "));
+    let all: Vec<TakeScore> = runs.iter().flatten().cloned().collect();
+    let (recall, precision) = recall_precision(&all);
+    let _ = writeln!(
+        out,
         "real doodles: recall {:.1}%, precision {:.1}%",
         100.0 * recall,
         100.0 * precision
     );
-    Ok(())
+    out
 }
 
 #[cfg(test)]
@@ -292,8 +366,43 @@ mod tests {
             labels: vec![String::new(); labels],
             events: vec![String::new(); events],
             hits,
+            found: (0..labels).map(|i| i < hits).collect(),
         };
         assert_eq!(recall_precision(&[s(2, 4, 1), s(2, 0, 0)]), (0.25, 0.25));
         assert_eq!(recall_precision(&[]), (1.0, 1.0));
+    }
+
+    fn score(labels: &[&str], events: &[&str], found: &[bool]) -> TakeScore {
+        TakeScore {
+            take: "t".into(),
+            labels: labels.iter().map(|l| l.to_string()).collect(),
+            events: events.iter().map(|e| e.to_string()).collect(),
+            hits: found.iter().filter(|&&f| f).count(),
+            found: found.to_vec(),
+        }
+    }
+
+    #[test]
+    fn a_report_over_libraries_sums_each_takes_hits_and_events() {
+        let one = vec![
+            score(&["turn", "walk"], &["turn", "run"], &[true, false]),
+            score(&[], &["run"], &[]),
+        ];
+        let two = vec![
+            score(&["turn", "walk"], &["walk"], &[false, true]),
+            score(&[], &[], &[]),
+        ];
+        let text = report(&[one.clone(), two]);
+        assert!(text.contains("summed over 2 libraries"), "{text}");
+        assert!(
+            text.contains("found per action: turn 1/2, walk 1/2"),
+            "{text}"
+        );
+        // 2 hits of 4 labels; 2 of 4 events.
+        assert!(text.contains("recall 50.0%, precision 50.0%"), "{text}");
+        let row: Vec<&str> = text.lines().nth(2).unwrap().split_whitespace().collect();
+        assert_eq!(row, ["t", "turn", "walk", "3", "2/4"], "{text}");
+        // One library lists its events by name.
+        assert!(report(&[one]).contains("turn run"));
     }
 }
