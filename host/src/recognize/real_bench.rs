@@ -83,7 +83,7 @@ pub struct RealBenchArgs {
     /// Learn this many libraries from the generator instead, as the shipped one is learnt (3
     /// examples per action, train seeds `--train-seed` on), and report over all of them: what
     /// one library reads is partly the luck of its examples.
-    #[arg(long, conflicts_with_all = ["library", "save"])]
+    #[arg(long, conflicts_with_all = ["library", "save"], value_parser = clap::value_parser!(u64).range(1..))]
     pub libraries: Option<u64>,
     /// First train seed of `--libraries` (the shipped library's is 1).
     #[arg(long, default_value_t = 1, requires = "libraries")]
