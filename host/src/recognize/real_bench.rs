@@ -99,10 +99,15 @@ pub struct TakeScore {
     pub labels: Vec<String>,
     /// Recognised actions, in order.
     pub events: Vec<String>,
-    /// Labels matched by an event.
-    pub hits: usize,
     /// Per label, whether an event matched it.
     pub found: Vec<bool>,
+}
+
+impl TakeScore {
+    /// Labels matched by an event.
+    pub fn hits(&self) -> usize {
+        self.found.iter().filter(|&&f| f).count()
+    }
 }
 
 /// Whether spans `a` and `b` (seconds) overlap by [`MIN_OVERLAP`] of the shorter.
@@ -196,12 +201,10 @@ pub fn score_takes(
             }
             found.push(hit.is_some());
         }
-        let hits = found.iter().filter(|&&f| f).count();
         out.push(TakeScore {
             take: format!("{}{} ({})", t.take, window(t), t.joint),
             labels: labels.into_iter().map(|(a, _)| a).collect(),
             events: sim.records.iter().map(|r| r.action.clone()).collect(),
-            hits,
             found,
         });
     }
@@ -209,10 +212,10 @@ pub fn score_takes(
 }
 
 /// Recall and precision over takes' scores (1 where nothing was there to find or report).
-pub fn recall_precision(scores: &[TakeScore]) -> (f64, f64) {
-    let hits: usize = scores.iter().map(|s| s.hits).sum();
-    let labels: usize = scores.iter().map(|s| s.labels.len()).sum();
-    let events: usize = scores.iter().map(|s| s.events.len()).sum();
+pub fn recall_precision<'a>(scores: impl IntoIterator<Item = &'a TakeScore>) -> (f64, f64) {
+    let (hits, labels, events) = scores.into_iter().fold((0, 0, 0), |(h, l, e), s| {
+        (h + s.hits(), l + s.labels.len(), e + s.events.len())
+    });
     let ratio = |n: usize, d: usize| if d == 0 { 1.0 } else { n as f64 / d as f64 };
     (ratio(hits, labels), ratio(hits, events))
 }
@@ -282,7 +285,7 @@ pub fn report(runs: &[Vec<TakeScore>]) -> String {
         let of_take = runs.iter().filter_map(|r| r.get(i));
         let (hits, events) = of_take
             .clone()
-            .fold((0, 0), |(h, e), t| (h + t.hits, e + t.events.len()));
+            .fold((0, 0), |(h, e), t| (h + t.hits(), e + t.events.len()));
         for t in of_take {
             for (label, &f) in t.labels.iter().zip(&t.found) {
                 let e = per_action.entry(label.as_str()).or_default();
@@ -309,8 +312,7 @@ pub fn report(runs: &[Vec<TakeScore>]) -> String {
         .map(|(a, (h, l))| format!("{a} {h}/{l}"))
         .collect();
     let _ = writeln!(out, "found per action: {}", recall.join(", "));
-    let all: Vec<TakeScore> = runs.iter().flatten().cloned().collect();
-    let (recall, precision) = recall_precision(&all);
+    let (recall, precision) = recall_precision(runs.iter().flatten());
     let _ = writeln!(
         out,
         "real doodles: recall {:.1}%, precision {:.1}%",
@@ -365,7 +367,6 @@ mod tests {
             take: String::new(),
             labels: vec![String::new(); labels],
             events: vec![String::new(); events],
-            hits,
             found: (0..labels).map(|i| i < hits).collect(),
         };
         assert_eq!(recall_precision(&[s(2, 4, 1), s(2, 0, 0)]), (0.25, 0.25));
@@ -377,7 +378,6 @@ mod tests {
             take: "t".into(),
             labels: labels.iter().map(|l| l.to_string()).collect(),
             events: events.iter().map(|e| e.to_string()).collect(),
-            hits: found.iter().filter(|&&f| f).count(),
             found: found.to_vec(),
         }
     }
