@@ -301,3 +301,53 @@ fn the_cli_tracks_a_rig_prints_its_tags_and_refuses_bad_rigs() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_figurine_held_still_in_view_is_tracked_and_read_for_false_alarms() {
+    use figurine_host::track::still::{run_still, still_report};
+    let dir = scratch("still");
+    let setup = Setup {
+        distance: 0.5,
+        seed: 4,
+        rig_box: Some(BoxSize::sides(0.08, 0.08)),
+        ..Setup::default()
+    };
+    let how = Tracking {
+        smooth: true,
+        region_search: true,
+        exposure_s: 0.008,
+    };
+    let r = run_still(&setup, 3.0, 7, &dir, how, false).unwrap();
+    // 3 s at 30 frames per second, nearly all of them tracked.
+    assert!(
+        (89..=91).contains(&r.frames.len()),
+        "{} frames",
+        r.frames.len()
+    );
+    let tracked = r.frames.iter().filter(|f| f.error.is_some()).count();
+    assert!(
+        tracked >= 80,
+        "{tracked} of {} frames tracked",
+        r.frames.len()
+    );
+    // A hand holding the figurine still plays no action; the tracker's own jitter adds turn
+    // between frames that the truth does not have.
+    assert!(r.truth_actions.is_empty(), "{:?}", r.truth_actions);
+    assert_eq!(r.tracked_turns_deg.len(), tracked - 1);
+    let median = |v: &[f64]| {
+        let mut v = v.to_vec();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    assert!(
+        median(&r.truth_turns_deg) < median(&r.tracked_turns_deg),
+        "truth {} tracked {}",
+        median(&r.truth_turns_deg),
+        median(&r.tracked_turns_deg)
+    );
+    let text = still_report(&[r]);
+    assert!(text.contains("| 0.50 m | 3 |"), "{text}");
+    // A bad length is refused with the option's name.
+    let err = run_still(&setup, -1.0, 7, &dir, how, false).unwrap_err();
+    assert!(err.to_string().contains("--rest-seconds"), "{err}");
+}

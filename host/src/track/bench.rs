@@ -3,7 +3,8 @@
 //! webcam's faults, encoded to MP4, decoded and tracked; the report gives position and
 //! orientation error by distance and by speed, frames lost, the time per frame, whether the
 //! recognizer reads the same actions from the tracked log as from the true one, and the
-//! tracked log's jitter at rest.
+//! tracked log's jitter at rest; then a figurine held still at each distance, read for false
+//! alarms ([`super::still`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -18,6 +19,7 @@ use super::eval::{
 };
 use super::render::Scene;
 use super::rig::{BoxSize, DEFAULT_BOX_M};
+use super::still::{run_still, still_report};
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::{gesture, Action, Effort, Knobs, Range};
 
@@ -68,6 +70,10 @@ pub struct BenchArgs {
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
     pub reuse: bool,
+    /// Seconds of a figurine held still in a hand at each distance, tracked and read for
+    /// false alarms ([`super::still`]; 0: none).
+    #[arg(long, default_value_t = 60.0)]
+    pub rest_seconds: f64,
 }
 
 /// One gesture tracked.
@@ -119,34 +125,19 @@ pub fn run_gesture(
     let placed = place(&doodle.log, setup.distance);
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
-    let frames_path = video.with_extension("frames.csv");
-    let kept = if reuse && video.exists() {
-        read_truths(&frames_path, setup, &sc).ok()
-    } else {
-        None
-    };
-    let truths = match kept {
+    let truths = match kept_truths(reuse, &video, setup, &sc) {
         Some(t) => t,
         None => {
             let t = render_video(setup, &sc, &placed, &video)?;
             if dir.join("keep").exists() {
-                write_truths(&frames_path, setup, &t)?;
+                write_truths(&video.with_extension("frames.csv"), setup, &t)?;
             }
             t
         }
     };
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);
-    let (lib, blob) = load_library(None)?;
-    let effort_model = load_effort(None)?;
-    let names = lib.names();
-    let read = |log: &crate::poselog::PoseLog| -> Result<Vec<String>> {
-        Ok(simulate_log(log, &names, &blob, Some(effort_model))?
-            .records
-            .into_iter()
-            .map(|r| r.action)
-            .collect())
-    };
+    let read = actions_of;
     let truth = truth_log(&truths);
     let truth_actions = read(&truth)?;
     let tracked_actions = read(&run.log)?;
@@ -174,8 +165,36 @@ pub fn run_gesture(
     })
 }
 
+/// The actions the shipped library and effort model read from `log`.
+pub(super) fn actions_of(log: &crate::poselog::PoseLog) -> Result<Vec<String>> {
+    let (lib, blob) = load_library(None)?;
+    let effort_model = load_effort(None)?;
+    Ok(simulate_log(log, &lib.names(), &blob, Some(effort_model))?
+        .records
+        .into_iter()
+        .map(|r| r.action)
+        .collect())
+}
+
+/// What each frame of `video` showed, when `reuse` asks for a kept video and its truths were
+/// kept for this setup.
+pub(super) fn kept_truths(
+    reuse: bool,
+    video: &std::path::Path,
+    setup: &Setup,
+    scene: &Scene,
+) -> Option<Vec<FrameTruth>> {
+    (reuse && video.exists())
+        .then(|| read_truths(&video.with_extension("frames.csv"), setup, scene).ok())
+        .flatten()
+}
+
 /// Writes what each frame of a kept video showed, for `--reuse`.
-fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) -> Result<()> {
+pub(super) fn write_truths(
+    path: &std::path::Path,
+    setup: &Setup,
+    truths: &[FrameTruth],
+) -> Result<()> {
     let mut text = format!(
         "{}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
         truths_head(setup)
@@ -404,6 +423,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             eprintln!("  {line}");
         }
     }
+    let how = Tracking {
+        smooth: !args.raw,
+        region_search: !args.whole_frames,
+        exposure_s: args.exposure_ms.max(0.0) / 1000.0,
+    };
     let mut runs = Vec::new();
     for (di, &distance) in args.distances.iter().enumerate() {
         let setup = Setup {
@@ -416,11 +440,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
-            let how = Tracking {
-                smooth: !args.raw,
-                region_search: !args.whole_frames,
-                exposure_s: args.exposure_ms.max(0.0) / 1000.0,
-            };
             let r = run_gesture(&setup, action, seed, &dir, how, args.reuse)?;
             let s = summarize(&r.frames);
             eprintln!(
@@ -436,7 +455,29 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             runs.push(r);
         }
     }
+    let mut stills = Vec::new();
+    if args.rest_seconds > 0.0 {
+        for (di, &distance) in args.distances.iter().enumerate() {
+            let setup = Setup {
+                distance,
+                tag_size: args.tag_size,
+                seed: args.seed.wrapping_add(di as u64),
+                rig_box,
+                ..Setup::default()
+            };
+            let seed = args.seed.wrapping_mul(1000) + (di * 100 + 99) as u64;
+            let r = run_still(&setup, args.rest_seconds, seed, &dir, how, args.reuse)?;
+            eprintln!(
+                "held still at {distance:.2} m: {} frames, truth {:?}, tracked {:?}",
+                r.frames.len(),
+                r.truth_actions,
+                r.tracked_actions
+            );
+            stills.push(r);
+        }
+    }
     print!("{}", report(&runs));
+    print!("{}", still_report(&stills));
     if args.keep.is_none() {
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -23,6 +23,7 @@ pub mod print;
 pub mod render;
 pub mod rig;
 pub mod smooth;
+pub mod still;
 pub mod tracker;
 pub mod video;
 
