@@ -25,6 +25,7 @@ pub mod rig;
 pub mod smooth;
 pub mod still;
 pub mod tracker;
+pub mod trial;
 pub mod video;
 
 use std::path::PathBuf;

@@ -19,12 +19,12 @@ use std::path::Path;
 use anyhow::Result;
 use glam::DQuat;
 
-use super::bench::{actions_of, kept_truths, knobs};
 use super::detect::Family;
 use super::eval::{
     compare, place, quantile, render_video, scene, track_video, truth_log, FrameError, FrameTruth,
     Setup, Tracking,
 };
+use super::trial::{actions_of, kept_truths, knobs, write_truths};
 use crate::poselog::PoseSample;
 use crate::synth::rest::{rest_log, RestKind, RestSpec, TRACKER_LEVELS};
 use crate::synth::Range;
@@ -91,7 +91,7 @@ pub fn run_still(
         None => render_video(setup, &sc, &placed, &video)?,
     };
     if dir.join("keep").exists() {
-        super::bench::write_truths(&video.with_extension("frames.csv"), setup, &truths)?;
+        write_truths(&video.with_extension("frames.csv"), setup, &truths)?;
     }
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);

@@ -1,0 +1,127 @@
+//! What one rendered trial of `figurine track bench` shares with the others: the motion the
+//! generator draws for it, the truths of a kept video (written beside it for `--keep`, read
+//! back for `--reuse`), and what the shipped library reads from a log.
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result};
+
+use super::eval::{tags_in_sight, FrameTruth, Setup};
+use super::render::Scene;
+use crate::recognize::simulate::{load_effort, load_library, simulate_log};
+use crate::synth::{Knobs, Range};
+
+/// The generator's knobs for tracked gestures: clean truth at 240 Hz (the renderer blurs
+/// between samples), small enough to stay in view at half a metre, a toy held a little
+/// crooked.
+pub fn knobs() -> Knobs {
+    Knobs {
+        scale: Range::new(0.4, 0.7),
+        speed: Range::new(0.8, 1.25),
+        tilt_deg: Range::new(0.0, 10.0),
+        rate_hz: Range::fixed(240.0),
+        ..Knobs::canonical()
+    }
+}
+
+/// The actions the shipped library and effort model read from `log`.
+pub fn actions_of(log: &crate::poselog::PoseLog) -> Result<Vec<String>> {
+    let (lib, blob) = load_library(None)?;
+    let effort_model = load_effort(None)?;
+    Ok(simulate_log(log, &lib.names(), &blob, Some(effort_model))?
+        .records
+        .into_iter()
+        .map(|r| r.action)
+        .collect())
+}
+
+/// What each frame of `video` showed, when `reuse` asks for a kept video and its truths were
+/// kept for this setup.
+pub fn kept_truths(
+    reuse: bool,
+    video: &std::path::Path,
+    setup: &Setup,
+    scene: &Scene,
+) -> Option<Vec<FrameTruth>> {
+    (reuse && video.exists())
+        .then(|| read_truths(&video.with_extension("frames.csv"), setup, scene).ok())
+        .flatten()
+}
+
+/// Writes what each frame of a kept video showed, for `--reuse`.
+pub fn write_truths(path: &std::path::Path, setup: &Setup, truths: &[FrameTruth]) -> Result<()> {
+    let mut text = format!(
+        "{}\nt,x,y,z,qw,qx,qy,qz,speed,hidden,log_t\n",
+        truths_head(setup)
+    );
+    for f in truths {
+        let p = &f.pose;
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            f.t,
+            p.pos[0],
+            p.pos[1],
+            p.pos[2],
+            p.quat[0],
+            p.quat[1],
+            p.quat[2],
+            p.quat[3],
+            f.speed,
+            u8::from(f.hidden),
+            p.t
+        );
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Reads what [`write_truths`] wrote; an error when it is missing, malformed or was written
+/// for another setup. A frame whose tags were all outside the picture is out of sight even if
+/// the file (written before that counted) says otherwise.
+pub fn read_truths(
+    path: &std::path::Path,
+    setup: &Setup,
+    scene: &Scene,
+) -> Result<Vec<FrameTruth>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut lines = text.lines();
+    let head = truths_head(setup);
+    anyhow::ensure!(lines.next() == Some(head.as_str()), "another setup");
+    lines.next();
+    lines
+        .map(|line| {
+            let v: Vec<f64> = line
+                .split(',')
+                .map(str::parse)
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("{}: {line}", path.display()))?;
+            anyhow::ensure!(v.len() == 11, "{}: {line}", path.display());
+            let pose = crate::poselog::PoseSample {
+                t: v[10],
+                pos: [v[1], v[2], v[3]],
+                quat: [v[4], v[5], v[6], v[7]],
+            };
+            Ok(FrameTruth {
+                t: v[0],
+                pose,
+                speed: v[8],
+                hidden: v[9] != 0.0 || tags_in_sight(scene, &pose) == 0,
+            })
+        })
+        .collect()
+}
+
+/// The first line of a kept video's truths: the setup it was drawn with.
+fn truths_head(setup: &Setup) -> String {
+    let rig = setup.rig_box.map_or(String::new(), |b| {
+        let top = b
+            .top
+            .map_or(String::new(), |h| format!(", top tag {h} m up"));
+        format!(", box {} × {} m{top}", b.width, b.depth)
+    });
+    format!(
+        "# tag {} m at {} m, seed {}{rig}",
+        setup.tag_size, setup.distance, setup.seed
+    )
+}
