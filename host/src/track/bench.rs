@@ -400,42 +400,4 @@ mod tests {
         assert!(text.contains("in 2 (66.7 %)\n"), "{text}");
         assert!(text.contains("truth with the gaps [\"turn\"]"), "{text}");
     }
-
-    #[test]
-    fn kept_truths_read_back_and_refuse_another_setup() {
-        let dir = std::env::temp_dir().join(format!("figurine-bench-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("frames.csv");
-        let setup = Setup::default();
-        let truths = vec![FrameTruth {
-            t: 0.1,
-            pose: crate::poselog::PoseSample {
-                t: 3.1,
-                pos: [0.1, -0.2, -0.7],
-                quat: [1.0, 0.0, 0.0, 0.0],
-            },
-            speed: 0.25,
-            hidden: true,
-        }];
-        write_truths(&path, &setup, &truths).unwrap();
-        let sc = scene(&setup, Family::Tag36h11, 0).unwrap();
-        assert_eq!(read_truths(&path, &setup, &sc).unwrap(), truths);
-        // Written as in sight but the tag is off the picture's left edge: out of sight.
-        let off = FrameTruth {
-            hidden: false,
-            pose: crate::poselog::PoseSample {
-                pos: [-0.45, 0.0, -0.7],
-                ..truths[0].pose
-            },
-            ..truths[0]
-        };
-        write_truths(&path, &setup, &[off]).unwrap();
-        assert!(read_truths(&path, &setup, &sc).unwrap()[0].hidden);
-        let other = Setup {
-            distance: 1.0,
-            ..setup
-        };
-        assert!(read_truths(&path, &other, &sc).is_err());
-        let _ = std::fs::remove_dir_all(&dir);
-    }
 }
