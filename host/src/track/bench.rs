@@ -28,7 +28,8 @@ pub struct BenchArgs {
     /// Distances from the camera to each gesture's start, metres.
     #[arg(long, value_delimiter = ',', default_values_t = [0.5, 0.75, 1.0])]
     pub distances: Vec<f64>,
-    /// Gestures per distance (actions in turn: walk, run, jump, …).
+    /// Gestures per distance (actions in turn: walk, run, jump, …; 0: the figurine held
+    /// still only, see `--rest-seconds`).
     #[arg(long, default_value_t = 12)]
     pub gestures: usize,
     /// Master seed.
@@ -123,10 +124,9 @@ pub fn run_gesture(
     };
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);
-    let read = actions_of;
     let truth = truth_log(&truths);
-    let truth_actions = read(&truth)?;
-    let tracked_actions = read(&run.log)?;
+    let truth_actions = actions_of(&truth)?;
+    let tracked_actions = actions_of(&run.log)?;
     let gapped = crate::poselog::PoseLog {
         samples: truth
             .samples
@@ -135,7 +135,7 @@ pub fn run_gesture(
             .copied()
             .collect(),
     };
-    let gapped_actions = read(&gapped)?;
+    let gapped_actions = actions_of(&gapped)?;
     if dir.join("keep").exists() {
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;
@@ -360,7 +360,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             stills.push(r);
         }
     }
-    print!("{}", report(&runs));
+    if !runs.is_empty() {
+        print!("{}", report(&runs));
+    }
     print!("{}", still_report(&stills));
     if args.keep.is_none() {
         let _ = std::fs::remove_dir_all(&dir);

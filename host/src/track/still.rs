@@ -88,11 +88,14 @@ pub fn run_still(
     let video = dir.join(format!("still-{seed}.mp4"));
     let truths: Vec<FrameTruth> = match kept_truths(reuse, &video, setup, &sc) {
         Some(t) => t,
-        None => render_video(setup, &sc, &placed, &video)?,
+        None => {
+            let t = render_video(setup, &sc, &placed, &video)?;
+            if dir.join("keep").exists() {
+                write_truths(&video.with_extension("frames.csv"), setup, &t)?;
+            }
+            t
+        }
     };
-    if dir.join("keep").exists() {
-        write_truths(&video.with_extension("frames.csv"), setup, &truths)?;
-    }
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log);
     let truth = truth_log(&truths);
@@ -167,8 +170,8 @@ pub fn still_report(runs: &[StillRun]) -> String {
     });
     let _ = writeln!(
         out,
-        "at rest: {tracked} actions from the tracked logs in {seconds:.0} s ({:.0} per hour), \
-         {truth} from the truth",
+        "at rest, {seconds:.0} s in all: actions from the tracked logs {tracked} ({:.0} per \
+         hour), from the truth {truth}",
         tracked as f64 * 3600.0 / seconds.max(1e-9)
     );
     for r in runs.iter().filter(|r| !r.tracked_actions.is_empty()) {
@@ -207,7 +210,7 @@ mod tests {
         );
         assert!(
             text.contains(
-                "at rest: 3 actions from the tracked logs in 120 s (90 per hour), 0 from the truth"
+                "at rest, 120 s in all: actions from the tracked logs 3 (90 per hour), from the truth 0"
             ),
             "{text}"
         );
