@@ -312,15 +312,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         region_search: !args.whole_frames,
         exposure_s: args.exposure_ms.max(0.0) / 1000.0,
     };
+    // The camera and picture at the di-th distance, alike for its gestures and its rest.
+    let setup_at = |di: usize, distance: f64| Setup {
+        distance,
+        tag_size: args.tag_size,
+        seed: args.seed.wrapping_add(di as u64),
+        rig_box,
+        ..Setup::default()
+    };
     let mut runs = Vec::new();
     for (di, &distance) in args.distances.iter().enumerate() {
-        let setup = Setup {
-            distance,
-            tag_size: args.tag_size,
-            seed: args.seed.wrapping_add(di as u64),
-            rig_box,
-            ..Setup::default()
-        };
+        let setup = setup_at(di, distance);
         for g in 0..args.gestures {
             let action = Action::ALL[g % Action::ALL.len()];
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + g) as u64;
@@ -342,13 +344,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut stills = Vec::new();
     if args.rest_seconds > 0.0 {
         for (di, &distance) in args.distances.iter().enumerate() {
-            let setup = Setup {
-                distance,
-                tag_size: args.tag_size,
-                seed: args.seed.wrapping_add(di as u64),
-                rig_box,
-                ..Setup::default()
-            };
+            let setup = setup_at(di, distance);
             let seed = args.seed.wrapping_mul(1000) + (di * 100 + 99) as u64;
             let r = run_still(&setup, args.rest_seconds, seed, &dir, how, args.reuse)?;
             eprintln!(

@@ -58,7 +58,8 @@ impl Default for Setup {
     }
 }
 
-fn quat(s: &PoseSample) -> DQuat {
+/// A sample's orientation as a unit quaternion.
+pub fn quat(s: &PoseSample) -> DQuat {
     DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize()
 }
 

@@ -17,12 +17,11 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use glam::DQuat;
 
 use super::detect::Family;
 use super::eval::{
-    compare, place, quantile, render_video, scene, track_video, truth_log, FrameError, FrameTruth,
-    Setup, Tracking,
+    compare, place, quantile, quat, render_video, scene, track_video, truth_log, FrameError,
+    FrameTruth, Setup, Tracking,
 };
 use super::trial::{actions_of, kept_truths, knobs, write_truths};
 use crate::poselog::PoseSample;
@@ -49,10 +48,6 @@ pub struct StillRun {
     pub tracked_turns_deg: Vec<f64>,
     /// The truth's turn between the same frames, degrees.
     pub truth_turns_deg: Vec<f64>,
-}
-
-fn quat(s: &PoseSample) -> DQuat {
-    DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize()
 }
 
 /// The turn between consecutive samples, degrees.
@@ -188,6 +183,7 @@ pub fn still_report(runs: &[StillRun]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DQuat;
 
     fn still(distance: f64, tracked: &[&str]) -> StillRun {
         StillRun {
