@@ -195,8 +195,11 @@ fn mirrored(q: DQuat, t: DVec3) -> Option<DQuat> {
 
 /// Both poses a flat square's corners admit (pixels, detector order; edge `size` metres): the
 /// homography's, refined, and its mirror about the line of sight, refined — the better fit
-/// first, each with its RMS corner reprojection error in pixels. One pose when the mirror
-/// does not exist (a tag square to the line of sight through its centre) or failed.
+/// first, each with its RMS corner reprojection error in pixels. When both refinements settle
+/// in one pose, the mirror is kept unrefined, with its own error: near face-on a frame's
+/// noise can leave one basin where the next frame has two, and the pose across the line of
+/// sight stays the other answer to weigh over time ([`super::mirror`]). One pose when the
+/// mirror does not exist (a tag square to the line of sight through its centre) or failed.
 pub fn solve_candidates(corners: &[[f64; 2]; 4], size: f64, k: &Intrinsics) -> Vec<CameraPose> {
     let obj = object_corners(size);
     let px: [DVec2; 4] = corners.map(|c| DVec2::new(c[0], c[1]));
@@ -213,10 +216,16 @@ pub fn solve_candidates(corners: &[[f64; 2]; 4], size: f64, k: &Intrinsics) -> V
         .map(|(q, t, err)| CameraPose::from_parts(DMat3::from_quat(q), t, err))
         .collect();
     out.sort_by(|a, b| a.error.total_cmp(&b.error));
-    // Both refinements may settle in the same pose (far from face-on the mirror's basin
-    // drains into the true one): one answer, not two.
+    // Both refinements may settle in the same pose (the mirror's basin drained into the
+    // other's): the mirror itself, unrefined, is the second answer.
     if out.len() == 2 && out[0].quat().dot(out[1].quat()).abs() > 1.0 - 1e-9 {
         out.truncate(1);
+        let (q, t, _) = first;
+        let unrefined = mirrored(q, t).map(|qm| (qm, rms(&residuals(qm, t, &obj, &px, k))));
+        if let Some((qm, err)) = unrefined.filter(|(qm, err)| err.is_finite() && qm.is_finite()) {
+            out.push(CameraPose::from_parts(DMat3::from_quat(qm), t, err));
+            out.sort_by(|a, b| a.error.total_cmp(&b.error));
+        }
     }
     out
 }
