@@ -327,13 +327,8 @@ mod tests {
         // crosses to the mirror now and then; the report must not jump by the poses' whole
         // separation (10°) when it does.
         let mut m = MirrorChooser::default();
-        let mut noise = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = || {
-            noise ^= noise << 13;
-            noise ^= noise >> 7;
-            noise ^= noise << 17;
-            (noise >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::synth::rng::SynthRng::from_u64(7);
+        let mut uniform = || rng.unit();
         let (mut hard_flips, mut last_hard, mut worst) = (0, 5.0, 0.0_f64);
         let mut last: Option<f64> = None;
         for i in 0..600 {

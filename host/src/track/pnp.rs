@@ -208,7 +208,16 @@ pub fn solve_candidates(corners: &[[f64; 2]; 4], size: f64, k: &Intrinsics) -> V
         return Vec::new();
     };
     let first = refine(q0, t0, &obj, &px, k);
-    let second = mirrored(first.0, first.1).map(|qm| refine(qm, first.1, &obj, &px, k));
+    let mirror = mirrored(first.0, first.1);
+    let (first, second) = match mirror.map(|qm| refine(qm, first.1, &obj, &px, k)) {
+        // Both refinements may settle in the same pose (the mirror's basin drained into the
+        // other's): the better of the two, and the mirror itself, unrefined, as the second.
+        Some(r) if r.0.dot(first.0).abs() > 1.0 - 1e-9 => (
+            if r.2 < first.2 { r } else { first },
+            mirror.map(|qm| (qm, first.1, rms(&residuals(qm, first.1, &obj, &px, k)))),
+        ),
+        other => (first, other),
+    };
     let mut out: Vec<CameraPose> = [Some(first), second]
         .into_iter()
         .flatten()
@@ -216,17 +225,6 @@ pub fn solve_candidates(corners: &[[f64; 2]; 4], size: f64, k: &Intrinsics) -> V
         .map(|(q, t, err)| CameraPose::from_parts(DMat3::from_quat(q), t, err))
         .collect();
     out.sort_by(|a, b| a.error.total_cmp(&b.error));
-    // Both refinements may settle in the same pose (the mirror's basin drained into the
-    // other's): the mirror itself, unrefined, is the second answer.
-    if out.len() == 2 && out[0].quat().dot(out[1].quat()).abs() > 1.0 - 1e-9 {
-        out.truncate(1);
-        let (q, t, _) = first;
-        let unrefined = mirrored(q, t).map(|qm| (qm, rms(&residuals(qm, t, &obj, &px, k))));
-        if let Some((qm, err)) = unrefined.filter(|(qm, err)| err.is_finite() && qm.is_finite()) {
-            out.push(CameraPose::from_parts(DMat3::from_quat(qm), t, err));
-            out.sort_by(|a, b| a.error.total_cmp(&b.error));
-        }
-    }
     out
 }
 
