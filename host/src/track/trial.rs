@@ -26,13 +26,17 @@ pub fn knobs() -> Knobs {
 
 /// The actions the shipped library and effort model read from `log`.
 pub fn actions_of(log: &crate::poselog::PoseLog) -> Result<Vec<String>> {
+    Ok(reading_of(log)?.0)
+}
+
+/// The actions the shipped library and effort model read from `log`, and the most edits any
+/// of them needed to match its pattern (0 when every one matched exactly, or none was read).
+pub fn reading_of(log: &crate::poselog::PoseLog) -> Result<(Vec<String>, u32)> {
     let (lib, blob) = load_library(None)?;
     let effort_model = load_effort(None)?;
-    Ok(simulate_log(log, &lib.names(), &blob, Some(effort_model))?
-        .records
-        .into_iter()
-        .map(|r| r.action)
-        .collect())
+    let records = simulate_log(log, &lib.names(), &blob, Some(effort_model))?.records;
+    let edits = records.iter().map(|r| r.distance).max().unwrap_or(0);
+    Ok((records.into_iter().map(|r| r.action).collect(), edits))
 }
 
 /// What each frame of `video` showed, when `reuse` asks for a kept video and its truths were
