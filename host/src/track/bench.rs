@@ -236,15 +236,16 @@ pub fn report(runs: &[GestureRun]) -> String {
     // a few millimetres of tracking error tip it: the share that agrees, by those edits.
     let _ = write!(out, "  by the edits the true log's reading needed:");
     for (label, lo, hi) in [("none", 0, 0), ("one", 1, 1), ("two or more", 2, u32::MAX)] {
-        let of = runs
+        let (n, same) = runs
             .iter()
             .filter(|r| (lo..=hi).contains(&r.truth_edits))
-            .collect::<Vec<_>>();
-        let same = of
-            .iter()
-            .filter(|r| r.truth_actions == r.tracked_actions)
-            .count();
-        let _ = write!(out, " {label}, the same in {same} of {};", of.len());
+            .fold((0, 0), |(n, same), r| {
+                (
+                    n + 1,
+                    same + usize::from(r.truth_actions == r.tracked_actions),
+                )
+            });
+        let _ = write!(out, " {label}, the same in {same} of {n};");
     }
     let _ = writeln!(out);
     for r in runs.iter().filter(|r| r.truth_actions != r.tracked_actions) {

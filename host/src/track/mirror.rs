@@ -183,13 +183,8 @@ impl MirrorChooser {
 /// toward the next cheapest by its share e^−Δ / (1 + e^−Δ) of the two, Δ their cost
 /// difference in nats; the best fit's corner error is kept. `None` without branches.
 fn posterior_mean(branches: &[Branch]) -> Option<CameraPose> {
-    let by_cost = |a: &&Branch, b: &&Branch| a.cost.total_cmp(&b.cost);
-    let best = branches.iter().min_by(by_cost)?;
-    let Some(other) = branches
-        .iter()
-        .filter(|b| !core::ptr::eq(*b, best))
-        .min_by(by_cost)
-    else {
+    let best = cheapest(branches.iter())?;
+    let Some(other) = cheapest(branches.iter().filter(|b| !core::ptr::eq(*b, best))) else {
         return Some(best.pose);
     };
     let w = (best.cost - other.cost).exp();
@@ -208,6 +203,11 @@ fn posterior_mean(branches: &[Branch]) -> Option<CameraPose> {
         ta.lerp(tb, share),
         best.pose.error.min(other.pose.error),
     ))
+}
+
+/// The branch ending the cheapest path (the hard choice the posterior mean softens).
+fn cheapest<'a>(branches: impl Iterator<Item = &'a Branch>) -> Option<&'a Branch> {
+    branches.min_by(|a, b| a.cost.total_cmp(&b.cost))
 }
 
 /// Angle between two rotations, radians (q and −q are the same).
@@ -345,13 +345,7 @@ mod tests {
                     &corners(0.3 * (i % 2) as f64),
                 )
                 .unwrap();
-            let hard = tilt_of(
-                &m.branches
-                    .iter()
-                    .min_by(|a, b| a.cost.total_cmp(&b.cost))
-                    .unwrap()
-                    .pose,
-            );
+            let hard = tilt_of(&cheapest(m.branches.iter()).unwrap().pose);
             if hard * last_hard < 0.0 && hard.abs() > 3.0 {
                 hard_flips += 1;
             }
