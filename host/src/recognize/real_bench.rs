@@ -80,14 +80,17 @@ pub struct RealBenchArgs {
     /// Also write each doodle here (one CSV per take, with its label lines).
     #[arg(long)]
     pub save: Option<PathBuf>,
-    /// Learn this many libraries from the generator instead, as the shipped one is learnt (3
-    /// examples per action, train seeds `--train-seed` on), and report over all of them: what
-    /// one library reads is partly the luck of its examples.
+    /// Learn this many libraries from the generator instead, as the shipped one is learnt
+    /// (`--examples` per action, train seeds `--train-seed` on), and report over all of them:
+    /// what one library reads is partly the luck of its examples.
     #[arg(long, conflicts_with_all = ["library", "save"], value_parser = clap::value_parser!(u64).range(1..))]
     pub libraries: Option<u64>,
     /// First train seed of `--libraries` (the shipped library's is 1).
     #[arg(long, default_value_t = 1, requires = "libraries")]
     pub train_seed: u64,
+    /// Examples per action of each `--libraries` library (the shipped library's: 3).
+    #[arg(long, default_value_t = 3, requires = "libraries")]
+    pub examples: usize,
 }
 
 /// One take's outcome.
@@ -239,7 +242,7 @@ pub fn run(args: &RealBenchArgs) -> Result<()> {
             let mut runs = Vec::new();
             for seed in args.train_seed..args.train_seed.saturating_add(n) {
                 eprintln!("learning a library at train seed {seed}…");
-                let mut lib = learn_synth_library(seed, 3, &Knobs::default())?;
+                let mut lib = learn_synth_library(seed, args.examples, &Knobs::default())?;
                 runs.push(score_takes(
                     &takes,
                     &lib.names(),
@@ -325,6 +328,23 @@ pub fn report(runs: &[Vec<TakeScore>]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        real: RealBenchArgs,
+    }
+
+    #[test]
+    fn learnt_libraries_take_as_many_examples_as_asked() {
+        let cli = Cli::try_parse_from(["real", "--libraries", "2", "--examples", "6"]).unwrap();
+        assert_eq!((cli.real.libraries, cli.real.examples), (Some(2), 6));
+        let cli = Cli::try_parse_from(["real", "--libraries", "2"]).unwrap();
+        assert_eq!(cli.real.examples, 3);
+        // Examples are for learnt libraries only: with the shipped one they mean nothing.
+        assert!(Cli::try_parse_from(["real", "--examples", "6"]).is_err());
+    }
 
     #[test]
     fn the_takes_parse_and_name_known_actions() {
