@@ -330,8 +330,10 @@ fn a_figurine_held_still_in_view_is_tracked_and_read_for_false_alarms() {
         "{tracked} of {} frames tracked",
         r.frames.len()
     );
-    // A hand holding the figurine still plays no action; the tracker's own jitter adds turn
-    // between frames that the truth does not have.
+    // A hand holding the figurine still plays no action. It wobbles a little from frame to
+    // frame; the tracked log turns by about as much, its smoothing taking out part of the
+    // hand's wobble as its jitter adds some (which of the two is larger depends on the
+    // encoder's bits), and stays far below the 2° orientation goal.
     assert!(r.truth_actions.is_empty(), "{:?}", r.truth_actions);
     assert_eq!(r.tracked_turns_deg.len(), tracked - 1);
     let median = |v: &[f64]| {
@@ -339,11 +341,11 @@ fn a_figurine_held_still_in_view_is_tracked_and_read_for_false_alarms() {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
+    let (truth, turned) = (median(&r.truth_turns_deg), median(&r.tracked_turns_deg));
+    assert!(truth > 0.0, "the hand does not wobble: {truth}°");
     assert!(
-        median(&r.truth_turns_deg) < median(&r.tracked_turns_deg),
-        "truth {} tracked {}",
-        median(&r.truth_turns_deg),
-        median(&r.tracked_turns_deg)
+        turned > 0.0 && turned < 0.5,
+        "tracked {turned}° per frame, truth {truth}°"
     );
     let text = still_report(&[r]);
     assert!(text.contains("| 0.50 m | 3 |"), "{text}");
