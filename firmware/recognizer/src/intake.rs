@@ -109,6 +109,10 @@ pub struct Intake {
     origin: [f32; 3],
     prev: Option<(u64, [f32; 3], [f32; 4])>,
     cur: Option<(u64, [f32; 3], [f32; 4], u32)>,
+    /// The latest accepted sample's unit orientation as received, sign-aligned: the next
+    /// sample's sign continues this one, not the low-passed state, whose lag would turn a
+    /// step near half a turn (a fast spin at 30 Hz) the other way round.
+    raw_quat: [f32; 4],
     next_tick_us: u64,
 }
 
@@ -133,6 +137,7 @@ impl Intake {
             origin: [0.0; 3],
             prev: None,
             cur: None,
+            raw_quat: [1.0, 0.0, 0.0, 0.0],
             next_tick_us: 0,
         }
     }
@@ -191,9 +196,10 @@ impl Intake {
             self.counters.jumps = self.counters.jumps.saturating_add(1);
             return Accept::Rejected;
         }
-        if fmath::qdot(q, q_prev) < 0.0 {
+        if fmath::qdot(q, self.raw_quat) < 0.0 {
             q = [-q[0], -q[1], -q[2], -q[3]];
         }
+        self.raw_quat = q;
         // First-order low-pass, exact for any sample spacing up to the discretisation
         // (dt / (τ + dt)): slow trackers pass nearly untouched, fast ones are averaged.
         let a = dt_us as f32 / (ANTI_ALIAS_TAU_US + dt_us) as f32;
@@ -223,6 +229,7 @@ impl Intake {
         self.origin = s.pos;
         self.prev = None;
         self.cur = Some((s.t_us, [0.0; 3], q, s.seq));
+        self.raw_quat = q;
         self.next_tick_us = s.t_us;
     }
 
@@ -400,6 +407,40 @@ mod tests {
             (lag_m - tau_s).abs() < 0.5e-3,
             "lag {lag_m} m, tau {tau_s} s"
         );
+    }
+
+    #[test]
+    fn a_spin_stepping_near_half_a_turn_per_sample_keeps_its_direction() {
+        // 172° about +Y per sample at 30 Hz: the low-pass trails each sample by about 15°, so
+        // the new sample is more than half a turn from the filtered state the short way; its
+        // sign must continue the previous sample, or the ticks turn back.
+        let step = 172.0f32.to_radians();
+        let mut i = Intake::new();
+        let mut ticks = heapless::Vec::<[f32; 4], 64>::new();
+        for k in 0..12u32 {
+            let half = 0.5 * step * k as f32;
+            let q = [libm::cosf(half), 0.0, libm::sinf(half), 0.0];
+            let quat = if k % 2 == 0 { q } else { q.map(|c| -c) };
+            i.push(&Sample {
+                seq: k,
+                t_us: u64::from(k) * 33_333,
+                pos: [0.0, 1.0, 0.0],
+                quat,
+            });
+            while let Some(t) = i.next_tick() {
+                ticks.push(t.quat).unwrap();
+            }
+        }
+        assert!(ticks.len() > 30);
+        for w in ticks.windows(2) {
+            let r = fmath::qmul(fmath::qconj(w[0]), w[1]);
+            assert!(
+                r[0] * r[2] > 0.0,
+                "a tick turned back: {:?} -> {:?}",
+                w[0],
+                w[1]
+            );
+        }
     }
 
     #[test]
