@@ -6,7 +6,9 @@
 //! What they never do is go as far as the action's examples went. So each action learns, from
 //! its examples, how far the least of them went (an [`Extent`]), and an event is reported only
 //! when its motion phrase went at least [`ACCEPT_SHARE`] of that, in a dimension that carries
-//! the action ([`far_enough`]).
+//! the action ([`far_enough`]), and farther than a fidget goes ([`FIDGET_MOVED_M`],
+//! [`FIDGET_TURNED_RAD`]): a tabletop player's examples of a few centimetres would otherwise
+//! admit a share smaller than the fidget itself.
 //!
 //! | measure | what | units |
 //! |---|---|---|
@@ -37,6 +39,12 @@ pub const ENOUGH_MOVED_M: f32 = 0.02;
 /// Rotation that is far enough for any action, rad (about 9°): a resting hand tilts the
 /// figurine by a few degrees.
 pub const ENOUGH_TURNED_RAD: f32 = 0.15;
+/// Displacement that is never far enough for an action, m, whatever its examples: just beyond
+/// the largest shift a hand's fidget makes (2–8 mm in `figurine synth rest`).
+pub const FIDGET_MOVED_M: f32 = 0.010;
+/// Rotation that is never far enough for an action, rad (about 6°): just beyond the largest
+/// tilt a hand's fidget makes (1–5°).
+pub const FIDGET_TURNED_RAD: f32 = 0.10;
 /// Share of the other dimension's least extent (rotation × [`ARM_M`]) a dimension must reach
 /// to carry an action: a punch barely turns and a turn barely moves; a kick and a throw carry
 /// both.
@@ -111,8 +119,14 @@ pub fn span_extent(hist: &History, from: u32, to: u32) -> Extent {
 pub fn far_enough(went: Extent, least: Extent) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
-    let need_moved = fmath::min(ACCEPT_SHARE * least.moved_m, ENOUGH_MOVED_M);
-    let need_turned = fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD);
+    let need_moved = fmath::max(
+        fmath::min(ACCEPT_SHARE * least.moved_m, ENOUGH_MOVED_M),
+        FIDGET_MOVED_M,
+    );
+    let need_turned = fmath::max(
+        fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD),
+        FIDGET_TURNED_RAD,
+    );
     (moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
         || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned)
 }
@@ -223,8 +237,22 @@ mod tests {
         assert!(far_enough(quarter, turn));
         let swing = ext(0.01, 0.2);
         assert!(far_enough(swing, throw));
-        // Examples that went nowhere admit anything.
-        assert!(far_enough(Extent::default(), Extent::default()));
+        // Examples that went nowhere admit anything that goes farther than a fidget.
+        assert!(far_enough(ext(0.012, 0.0), Extent::default()));
+        assert!(!far_enough(Extent::default(), Extent::default()));
+    }
+
+    #[test]
+    fn a_fidget_is_no_action_even_for_a_tabletop_players_library() {
+        // Examples of 3 cm and 40°: a share of them is a few millimetres and degrees, which a
+        // hand's fidget reaches; the fidget's own reach is the bound then.
+        let small = ext(0.03, 0.0);
+        assert!(ACCEPT_SHARE * small.moved_m < 0.008);
+        assert!(!far_enough(ext(0.008, 0.0), small));
+        assert!(far_enough(ext(0.012, 0.0), small));
+        let small_turn = ext(0.0, 0.7);
+        assert!(!far_enough(ext(0.0, 0.09), small_turn));
+        assert!(far_enough(ext(0.0, 0.12), small_turn));
     }
 
     #[test]

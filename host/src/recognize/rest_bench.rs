@@ -22,7 +22,7 @@ use super::simulate::{load_effort, load_library};
 use crate::chart::{bar_chart, save_png, BarChart, BarPanel};
 use crate::synth::rest::MAX_REST_SECONDS;
 use crate::synth::sequence::item_seed;
-use crate::synth::{rest_log, Knobs, RestKind, RestSpec, TrackerLevel, TRACKER_LEVELS};
+use crate::synth::{rest_log, Knobs, Range, RestKind, RestSpec, TrackerLevel, TRACKER_LEVELS};
 
 /// Arguments of `figurine eval rest`.
 #[derive(Args, Debug, Clone)]
@@ -47,6 +47,10 @@ pub struct RestBenchArgs {
     /// Examples per action of the learnt libraries.
     #[arg(long, default_value_t = 3)]
     pub examples: usize,
+    /// Spatial scale of the learnt libraries' examples (default 0.5..2; a tabletop player's
+    /// 0.3 makes gestures of about 4 cm, only a few times a fidget's reach).
+    #[arg(long)]
+    pub scale: Option<Range>,
     /// Also draw false alarms per hour by tracker level and kind as a PNG bar chart here.
     #[arg(long)]
     pub plot: Option<PathBuf>,
@@ -344,7 +348,11 @@ pub fn run(args: &RestBenchArgs) -> Result<()> {
     let learnt: Vec<Counted> = seeds
         .par_iter()
         .map(|&s| {
-            let mut lib = learn_synth_library(s, args.examples, &Knobs::default())?;
+            let mut knobs = Knobs::default();
+            if let Some(r) = args.scale {
+                knobs.scale = r;
+            }
+            let mut lib = learn_synth_library(s, args.examples, &knobs)?;
             Ok(Counted {
                 names: lib.names(),
                 blob: lib.blob()?,
@@ -363,9 +371,13 @@ pub fn run(args: &RestBenchArgs) -> Result<()> {
     let samples: usize = counts.iter().map(|c| c.samples).sum();
     println!(
         "Rest logs (seed {}): {per_cell} of {} min per kind × tracker level; every event is a \
-         false alarm. Libraries: shipped, and {} learnt from {} examples per action (seeds \
-         {seeds:?}).",
-        args.seed, args.minutes, args.learnt, args.examples
+         false alarm. Libraries: shipped, and {} learnt from {} examples per action at scale \
+         {} (seeds {seeds:?}).",
+        args.seed,
+        args.minutes,
+        args.learnt,
+        args.examples,
+        args.scale.unwrap_or(Knobs::default().scale)
     );
     print!("{}", table(&rows, &total, learnt.len()));
     let mut by_action = std::collections::BTreeMap::<&str, usize>::new();
