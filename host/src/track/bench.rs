@@ -1,10 +1,10 @@
 //! `figurine track bench`: the tracker against the truth. Generated gestures (every action in
 //! turn, random effort) are placed in front of the camera at each distance, rendered with the
 //! webcam's faults, encoded to MP4, decoded and tracked; the report gives position and
-//! orientation error by distance and by speed, frames lost, the time per frame, whether the
-//! recognizer reads the same actions from the tracked log as from the true one, and the
-//! tracked log's jitter at rest; then a figurine held still at each distance, read for false
-//! alarms ([`super::still`]).
+//! orientation error by distance, by speed and by turn rate, frames lost, the time per frame,
+//! whether the recognizer reads the same actions from the tracked log as from the true one,
+//! and the tracked log's jitter at rest; then a figurine held still at each distance, read for
+//! false alarms ([`super::still`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -14,8 +14,8 @@ use clap::Args;
 
 use super::detect::Family;
 use super::eval::{
-    compare, place, quantile, render_video, scene, still_noise, summarize, track_video, truth_log,
-    FrameError, Noise, Setup, Summary, Tracking,
+    compare, place, quantile, quat, render_video, scene, still_noise, summarize, track_video,
+    truth_log, FrameError, Noise, Setup, Summary, Tracking,
 };
 use super::rig::{BoxSize, DEFAULT_BOX_M};
 use super::still::{run_still, still_report};
@@ -155,6 +155,27 @@ pub fn run_gesture(
     })
 }
 
+/// Turn rate below which a frame counts as moving without turning in the report's last speed
+/// row, rad/s: a tag's face then smears along a line, which the blur retry can undo.
+pub const SLOW_TURN_RAD_S: f64 = 5.0;
+
+/// Each frame of one gesture with the figurine's true turn rate there, rad/s: the angle
+/// between its neighbours' orientations over their time apart (one-sided at the ends).
+fn turn_rates(frames: &[FrameError]) -> Vec<(&FrameError, f64)> {
+    let last = frames.len().saturating_sub(1);
+    frames
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let (a, b) = (&frames[i.saturating_sub(1)], &frames[(i + 1).min(last)]);
+            let dt = b.truth.t - a.truth.t;
+            let angle = quat(&a.truth.pose).angle_between(quat(&b.truth.pose));
+            let rate = if dt > 0.0 { angle / dt } else { 0.0 };
+            (f, if rate.is_finite() { rate } else { 0.0 })
+        })
+        .collect()
+}
+
 fn row(out: &mut String, label: &str, s: &Summary) {
     let _ = writeln!(
         out,
@@ -201,6 +222,40 @@ pub fn report(runs: &[GestureRun]) -> String {
             row(&mut out, &format!("{lo:.2}–{hi:.2}"), &s);
         }
     }
+    // Motion blur grows with how fast the tag's face turns as much as with how fast it moves:
+    // the lost frames' cause shows by turn rate, and at speed without turning.
+    let turning: Vec<(&FrameError, f64)> =
+        runs.iter().flat_map(|r| turn_rates(&r.frames)).collect();
+    let _ = writeln!(out, "\nby turn rate (rad/s)\n| turn rate {head}");
+    for (lo, hi) in [
+        (0.0, 2.0),
+        (2.0, 5.0),
+        (5.0, 10.0),
+        (10.0, 20.0),
+        (20.0, f64::INFINITY),
+    ] {
+        let s = summarize(
+            turning
+                .iter()
+                .filter(|(_, w)| *w >= lo && *w < hi)
+                .map(|(f, _)| *f),
+        );
+        let label = if hi.is_finite() {
+            format!("{lo:.0}–{hi:.0}")
+        } else {
+            format!("{lo:.0} and more")
+        };
+        if s.frames > 0 {
+            row(&mut out, &label, &s);
+        }
+    }
+    let s = summarize(
+        turning
+            .iter()
+            .filter(|(f, w)| *w < SLOW_TURN_RAD_S && f.truth.speed >= 0.5 && f.truth.speed < 1.0)
+            .map(|(f, _)| *f),
+    );
+    row(&mut out, "0.5–1 m/s, turning under 5 rad/s", &s);
     let s = summarize(all.iter().copied());
     let _ = writeln!(out, "\nall\n| all {head}");
     row(&mut out, "all", &s);
@@ -440,5 +495,48 @@ mod tests {
             ),
             "{text}"
         );
+    }
+
+    #[test]
+    fn lost_frames_are_told_apart_by_how_fast_the_figurine_turned() {
+        // A yaw at 3 rad/s, then at 30 rad/s, at 30 fps; the fast half loses every other frame.
+        let frames: Vec<FrameError> = (0..20)
+            .map(|i| {
+                let t = i as f64 / 30.0;
+                let yaw = if i < 10 {
+                    3.0 * t
+                } else {
+                    3.0 / 3.0 + 30.0 * (t - 1.0 / 3.0)
+                };
+                let q = glam::DQuat::from_rotation_y(yaw);
+                let pose = crate::poselog::PoseSample {
+                    t,
+                    pos: [0.0, 0.0, -0.5],
+                    quat: [q.w, q.x, q.y, q.z],
+                };
+                let lost = i >= 10 && i % 2 == 0;
+                FrameError {
+                    truth: super::super::eval::FrameTruth {
+                        t,
+                        pose,
+                        speed: 0.1,
+                        hidden: false,
+                    },
+                    error: (!lost).then_some((1.0, 1.0)),
+                    delta: None,
+                    tracked: None,
+                }
+            })
+            .collect();
+        let rates: Vec<f64> = turn_rates(&frames).iter().map(|(_, w)| *w).collect();
+        assert!((rates[1] - 3.0).abs() < 1e-9, "{rates:?}");
+        assert!((rates[15] - 30.0).abs() < 1e-9, "{rates:?}");
+        let mut r = run(&["turn"], &["turn"], &["turn"]);
+        r.frames = frames;
+        let text = report(&[r]);
+        // The frame at the change of rate sees one neighbour of each: 16.5 rad/s.
+        assert!(text.contains("| 2–5 | 10 | 0.0 %"), "{text}");
+        assert!(text.contains("| 10–20 | 1 | 100.0 %"), "{text}");
+        assert!(text.contains("| 20 and more | 9 | 44.4 %"), "{text}");
     }
 }
