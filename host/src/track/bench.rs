@@ -255,7 +255,9 @@ pub fn report(runs: &[GestureRun]) -> String {
             .filter(|(f, w)| *w < SLOW_TURN_RAD_S && f.truth.speed >= 0.5 && f.truth.speed < 1.0)
             .map(|(f, _)| *f),
     );
-    row(&mut out, "0.5–1 m/s, turning under 5 rad/s", &s);
+    if s.frames > 0 {
+        row(&mut out, "0.5–1 m/s, turning under 5 rad/s", &s);
+    }
     let s = summarize(all.iter().copied());
     let _ = writeln!(out, "\nall\n| all {head}");
     row(&mut out, "all", &s);
