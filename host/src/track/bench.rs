@@ -256,7 +256,8 @@ pub fn report(runs: &[GestureRun]) -> String {
             .map(|(f, _)| *f),
     );
     if s.frames > 0 {
-        row(&mut out, "0.5–1 m/s, turning under 5 rad/s", &s);
+        let label = format!("0.5–1 m/s, turning under {SLOW_TURN_RAD_S:.0} rad/s");
+        row(&mut out, &label, &s);
     }
     let s = summarize(all.iter().copied());
     let _ = writeln!(out, "\nall\n| all {head}");
