@@ -59,6 +59,17 @@ pub struct RestBenchArgs {
     pub verbose: bool,
 }
 
+impl RestBenchArgs {
+    /// The generator's knobs for the learnt libraries' examples (`--scale`, else the defaults).
+    pub fn learn_knobs(&self) -> Knobs {
+        let mut k = Knobs::default();
+        if let Some(r) = self.scale {
+            k.scale = r;
+        }
+        k
+    }
+}
+
 /// One kind of rest under one tracker level: a row of the table.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cell {
@@ -348,11 +359,7 @@ pub fn run(args: &RestBenchArgs) -> Result<()> {
     let learnt: Vec<Counted> = seeds
         .par_iter()
         .map(|&s| {
-            let mut knobs = Knobs::default();
-            if let Some(r) = args.scale {
-                knobs.scale = r;
-            }
-            let mut lib = learn_synth_library(s, args.examples, &knobs)?;
+            let mut lib = learn_synth_library(s, args.examples, &args.learn_knobs())?;
             Ok(Counted {
                 names: lib.names(),
                 blob: lib.blob()?,
@@ -377,7 +384,7 @@ pub fn run(args: &RestBenchArgs) -> Result<()> {
         args.minutes,
         args.learnt,
         args.examples,
-        args.scale.unwrap_or(Knobs::default().scale)
+        args.learn_knobs().scale
     );
     print!("{}", table(&rows, &total, learnt.len()));
     let mut by_action = std::collections::BTreeMap::<&str, usize>::new();
@@ -473,6 +480,21 @@ mod tests {
             summary(&total, 2),
             "rest: 2.0 h, false alarms per hour: shipped 1.50, learnt 1.50"
         );
+    }
+
+    #[test]
+    fn learnt_libraries_take_the_scale_asked() {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            rest: RestBenchArgs,
+        }
+        use clap::Parser as _;
+        let cli = Cli::try_parse_from(["rest", "--scale", "0.3"]).unwrap();
+        assert_eq!(cli.rest.learn_knobs().scale, Range::new(0.3, 0.3));
+        let cli = Cli::try_parse_from(["rest"]).unwrap();
+        assert_eq!(cli.rest.learn_knobs().scale, Knobs::default().scale);
+        assert!(Cli::try_parse_from(["rest", "--scale", "big"]).is_err());
     }
 
     #[test]
