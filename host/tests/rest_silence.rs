@@ -4,6 +4,7 @@
 
 use figurine_host::link::blobs::{self, Blobs};
 use figurine_host::poselog::PoseLog;
+use figurine_host::recognize::eval::learn_synth_library;
 use figurine_host::recognize::feed::{log_samples, Clock};
 use figurine_host::recognize::library::LibraryFile;
 use figurine_host::recognize::simulate::simulate_log;
@@ -112,6 +113,47 @@ fn fidgets_that_spell_an_action_are_no_action() {
             "the fidget at {at} s spells `{action}`"
         );
         assert_eq!(read(&b.library), Vec::<String>::new(), "seed {seed}");
+    }
+}
+
+/// A tabletop player's library — examples of a few centimetres, learnt at doodle scale 0.3 —
+/// admits a share of its least example smaller than a hand's fidget; the fidget's own reach
+/// bounds it. A webcam-far hand rest at 30 Hz on which such a library read a fidget as a
+/// sidestep (found with `figurine eval rest --scale 0.3` and `synth rest --seed 16 --kind hand
+/// --tracker webcam-far --rate 30`) stays silent, and the library still reads punches of its
+/// own scale.
+#[test]
+fn a_tabletop_players_library_stays_silent_through_a_hands_fidgets() {
+    let knobs = Knobs {
+        scale: Range::new(0.3, 0.3),
+        ..Knobs::default()
+    };
+    let mut lib = learn_synth_library(21, 3, &knobs).unwrap();
+    let (names, blob) = (lib.names(), lib.blob().unwrap());
+    let (_, effort) = shipped();
+    let rest = rest_log(
+        16,
+        &RestSpec {
+            seconds: 600.0,
+            kind: Some(RestKind::Hand),
+            tracker: TrackerLevel::by_name("webcam-far"),
+            rate_hz: Some(Range::new(30.0, 30.0)),
+            ..RestSpec::default()
+        },
+    );
+    assert!(!rest.info.fidgets.is_empty());
+    let sim = simulate_log(&rest.log, &names, &blob, Some(effort)).unwrap();
+    let read: Vec<String> = sim.records.iter().map(|r| r.action.clone()).collect();
+    assert!(read.is_empty(), "{read:?}");
+    let effort_played = Effort {
+        time: TimeClass::Sudden,
+        weight: WeightClass::Light,
+    };
+    for seed in 1..=3 {
+        let d = gesture(seed, &knobs, Action::Punch, effort_played);
+        let sim = simulate_log(&d.log, &names, &blob, Some(effort)).unwrap();
+        let read: Vec<String> = sim.records.iter().map(|r| r.action.clone()).collect();
+        assert_eq!(read, ["punch"], "seed {seed}");
     }
 }
 
