@@ -176,6 +176,27 @@ fn turn_rates(frames: &[FrameError]) -> Vec<(&FrameError, f64)> {
         .collect()
 }
 
+/// A table's rows: the frames whose key lies in each bin `[lo, hi)`, labelled by `label`;
+/// empty bins are left out.
+fn binned(
+    out: &mut String,
+    frames: &[(&FrameError, f64)],
+    bins: &[(f64, f64)],
+    label: impl Fn(f64, f64) -> String,
+) {
+    for &(lo, hi) in bins {
+        let s = summarize(
+            frames
+                .iter()
+                .filter(|(_, k)| *k >= lo && *k < hi)
+                .map(|(f, _)| *f),
+        );
+        if s.frames > 0 {
+            row(out, &label(lo, hi), &s);
+        }
+    }
+}
+
 fn row(out: &mut String, label: &str, s: &Summary) {
     let _ = writeln!(
         out,
@@ -196,59 +217,40 @@ pub fn report(runs: &[GestureRun]) -> String {
     let all: Vec<&FrameError> = runs.iter().flat_map(|r| &r.frames).collect();
     let head = "| frames | lost | position error median / p90, mm | orientation error median / p90, ° |\n|---|---|---|---|---|";
     let _ = writeln!(out, "by distance from the camera (m)\n| distance {head}");
-    for (lo, hi) in [(0.2, 0.5), (0.5, 0.75), (0.75, 1.0), (1.0, 1.5)] {
-        let s = summarize(all.iter().copied().filter(|f| {
-            let d = -f.truth.pose.pos[2];
-            d >= lo && d < hi
-        }));
-        if s.frames > 0 {
-            row(&mut out, &format!("{lo:.2}–{hi:.2}"), &s);
-        }
-    }
+    let keyed = |key: fn(&FrameError) -> f64| all.iter().map(|&f| (f, key(f))).collect();
+    let hundredths = |lo: f64, hi: f64| format!("{lo:.2}–{hi:.2}");
+    let by_distance: Vec<_> = keyed(|f| -f.truth.pose.pos[2]);
+    let distances = [(0.2, 0.5), (0.5, 0.75), (0.75, 1.0), (1.0, 1.5)];
+    binned(&mut out, &by_distance, &distances, hundredths);
     let _ = writeln!(out, "\nby speed (m/s)\n| speed {head}");
-    for (lo, hi) in [
+    let by_speed: Vec<_> = keyed(|f| f.truth.speed);
+    let speeds = [
         (0.0, 0.05),
         (0.05, 0.25),
         (0.25, 0.5),
         (0.5, 1.0),
         (1.0, 9.0),
-    ] {
-        let s = summarize(
-            all.iter()
-                .copied()
-                .filter(|f| f.truth.speed >= lo && f.truth.speed < hi),
-        );
-        if s.frames > 0 {
-            row(&mut out, &format!("{lo:.2}–{hi:.2}"), &s);
-        }
-    }
+    ];
+    binned(&mut out, &by_speed, &speeds, hundredths);
     // Motion blur grows with how fast the tag's face turns as much as with how fast it moves:
     // the lost frames' cause shows by turn rate, and at speed without turning.
     let turning: Vec<(&FrameError, f64)> =
         runs.iter().flat_map(|r| turn_rates(&r.frames)).collect();
     let _ = writeln!(out, "\nby turn rate (rad/s)\n| turn rate {head}");
-    for (lo, hi) in [
+    let rates = [
         (0.0, 2.0),
         (2.0, 5.0),
         (5.0, 10.0),
         (10.0, 20.0),
         (20.0, f64::INFINITY),
-    ] {
-        let s = summarize(
-            turning
-                .iter()
-                .filter(|(_, w)| *w >= lo && *w < hi)
-                .map(|(f, _)| *f),
-        );
-        let label = if hi.is_finite() {
+    ];
+    binned(&mut out, &turning, &rates, |lo, hi| {
+        if hi.is_finite() {
             format!("{lo:.0}–{hi:.0}")
         } else {
             format!("{lo:.0} and more")
-        };
-        if s.frames > 0 {
-            row(&mut out, &label, &s);
         }
-    }
+    });
     let s = summarize(
         turning
             .iter()
