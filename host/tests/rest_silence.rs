@@ -57,11 +57,13 @@ fn rest_under_every_tracker_gives_no_event() {
 
 /// Hand rests on which the shipped library, before it learnt how far its examples went,
 /// read a fidget as an action (`figurine eval rest --verbose`): the rest's seed, its tracker,
-/// when the fidget's event began (s), and the action it was read as.
-const FIDGETS_ONCE_READ: [(u64, &str, f64, &str); 3] = [
+/// when the fidget's event began (s), and the action it was read as. (A third, an IMU-fusion
+/// fidget at 115.41 s of seed 2724813854111988808 read as a wave, is no longer read even
+/// without the extents: it strayed from every pattern and moved like no action's examples,
+/// which `nearest` no longer reads as the least unlike.)
+const FIDGETS_ONCE_READ: [(u64, &str, f64, &str); 2] = [
     (6_854_274_470_864_460_927, "lighthouse", 22.44, "turn"),
     (16_958_851_266_643_440_245, "lighthouse", 121.04, "bow"),
-    (2_724_813_854_111_988_808, "imu-fusion", 115.41, "wave"),
 ];
 
 /// The shipped library's actions as they are, and without their learnt extents.

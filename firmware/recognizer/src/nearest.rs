@@ -26,8 +26,9 @@
 //! among those within [`CLOSED_SHARE`] whose examples it moved not too unlike
 //! ([`CLOSED_SHAPE_MAX`]): a small kick whose swing fell under the lever-arm threshold, read
 //! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
-//! When it moved plainly unlike every action's examples, the shape tells none from another
-//! and the tokens decide: a kick flicked high (`uf.Xn db.Xp`) where every example swung flat.
+//! When it moved plainly unlike every action's examples, it is none of them: a toy carried to
+//! another spot or lifted and set back down is no action, however its strokes happen to be
+//! written.
 //!
 //! A loose reading also settles a match the automata did make but whose motion is plainly
 //! unlike its action's examples ([`reread`]): when another action's pattern nearly fits the
@@ -186,8 +187,7 @@ pub fn nearest_action(
 
 /// The reading of a closed phrase ([`nearest_action`]) with the highest merit per aligned
 /// token, shape cost included ([`Candidate::merit`]), among the actions that read it within
-/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike — or no
-/// more unlike than the action it moved least unlike, when that is further.
+/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike.
 fn closed_reading(
     lib: &Library<'_>,
     tokens: &[Token],
@@ -196,10 +196,9 @@ fn closed_reading(
     observed: &Shape,
 ) -> Option<Candidate> {
     let mut top: Option<(Candidate, usize)> = None;
-    let most = least_penalty(lib, observed).max(CLOSED_SHAPE_MAX);
     for a in 0..lib.len() {
         // An action without a learnt shape gives no evidence the phrase moved like it.
-        let Some(penalty) = penalty_of(lib, a, observed).filter(|&p| p <= most) else {
+        let Some(penalty) = penalty_of(lib, a, observed).filter(|&p| p <= CLOSED_SHAPE_MAX) else {
             continue;
         };
         let Some((mut c, aligned)) = loose_reading(lib, a, tokens, first, last, CLOSED_SHARE)
@@ -398,9 +397,9 @@ pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 pub const CLOSED_SHARE: (usize, usize) = (1, 1);
 
 /// Most shape penalty ([`crate::shape::shape_penalty`], quarter tokens) an action may have
-/// for a closed phrase to be read as it, unless every action has more ([`nearest_action`]):
-/// half the cap, so a phrase is never read as an action whose examples moved altogether
-/// otherwise while another's moved about as it did.
+/// for a closed phrase to be read as it ([`nearest_action`]): half the cap, so a phrase is
+/// never read as an action whose examples moved altogether otherwise. A phrase that strays
+/// from every action's tokens *and* moved unlike all their examples is no action.
 pub const CLOSED_SHAPE_MAX: i16 = SHAPE_CAP / 2;
 
 #[cfg(test)]
@@ -659,11 +658,11 @@ mod tests {
         assert_eq!(read(&shapes, false), None);
         assert_eq!(read(&shapes, true), Some((2, 1, 2, 3 * FULL)));
         // Not an action whose examples moved otherwise while the kick's moved as it did (the
-        // crouch reads it at a higher merit) — but when it moved unlike every action's
-        // examples, the shape tells none from another, and the tokens decide: the crouch `d u`
-        // (two edits in two tokens) over the kick and the punch (three edits in three).
+        // crouch reads it at a higher merit) — and when it moved unlike every action's
+        // examples, as none: a toy carried or lifted strays from every pattern and moves
+        // like no action, and is no action.
         let unlike = [shapes[0], shapes[1], Some(shape_bytes(up))];
-        assert_eq!(read(&unlike, true).map(|c| c.0), Some(1));
+        assert_eq!(read(&unlike, true), None);
         // Nor an action without a learnt shape.
         assert_eq!(read(&[None; 3], true), None);
         // Among those it moved like, the highest merit per aligned token: the crouch `d u`

@@ -10,6 +10,8 @@
 //! - Time, Weight and state accuracy of the correctly recognised isolated gestures;
 //! - sequences: events matched to labels (same action, overlapping in time, one-to-one),
 //!   precision, recall and F1, and why the unmatched events did not match ([`ExtraKind`]);
+//! - handling that plays no action ([`Handling`]: the toy carried elsewhere, lifted and set
+//!   down; `--isolated` logs of each kind): the share on which nothing is reported;
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
 //!
@@ -26,8 +28,11 @@ use super::feed::{log_samples, recognize_log, Clock};
 use super::learn::learn_action;
 use super::library::LibraryFile;
 use super::simulate::load_effort;
-use crate::synth::{self, Action, Doodle, Knobs, Label, Range, TimeClass, WeightClass};
+use crate::synth::{self, Action, Doodle, Handling, Knobs, Label, Range, TimeClass, WeightClass};
 use figurine_recognizer::{EffortModel, Library, Recognizer};
+
+/// Mixed into the test seed for the handling logs, so they are drawn apart from the gestures.
+const HANDLING_SEED: u64 = 0x4a_4d1e;
 
 /// Arguments of `figurine eval` (the accuracy tables).
 #[derive(Args, Debug)]
@@ -213,6 +218,20 @@ pub struct Figures {
     pub confusions: Vec<(String, String, usize)>,
     /// Sequence events that match no label (the false positives of the F1), by kind.
     pub extra: ExtraEvents,
+    /// Per kind of handling that plays no action ([`Handling`]): (name, events reported,
+    /// logs with any event, logs).
+    pub handling: Vec<(String, usize, usize, usize)>,
+}
+
+impl Figures {
+    /// Share of handling logs on which nothing was reported (1 when there were none).
+    pub fn silent(&self) -> f64 {
+        let (loud, n) = self
+            .handling
+            .iter()
+            .fold((0, 0), |a, h| (a.0 + h.2, a.1 + h.3));
+        1.0 - loud as f64 / n.max(1) as f64
+    }
 }
 
 /// Sequence events that match no label, counted by why.
@@ -224,6 +243,8 @@ pub struct ExtraEvents {
     pub wrong: usize,
     /// Overlaps no gesture (in a pause between them).
     pub spurious: usize,
+    /// Overlaps no gesture but handling that plays no action ([`Handling`]).
+    pub handled: usize,
 }
 
 /// Why a sequence event matched no label.
@@ -235,17 +256,22 @@ pub enum ExtraKind {
     Wrong,
     /// Over no gesture.
     Spurious,
+    /// Over no gesture, but over handling that plays no action.
+    Handled,
 }
 
 impl ExtraKind {
-    /// Classifies an unmatched event `e` against the sequence's labels.
-    pub fn of(e: &Ev, labels: &[Label]) -> ExtraKind {
-        let mut under = labels
-            .iter()
-            .filter(|l| overlap(e.start, e.end, l.start, l.end) > 0.0)
-            .peekable();
+    /// Classifies an unmatched event `e` against the sequence's labels and its spans of
+    /// `handled` toy.
+    pub fn of(e: &Ev, labels: &[Label], handled: &[Label]) -> ExtraKind {
+        let over = |l: &&Label| overlap(e.start, e.end, l.start, l.end) > 0.0;
+        let mut under = labels.iter().filter(over).peekable();
         if under.peek().is_none() {
-            ExtraKind::Spurious
+            if handled.iter().any(|h| over(&h)) {
+                ExtraKind::Handled
+            } else {
+                ExtraKind::Spurious
+            }
         } else if under.any(|l| l.action == e.action) {
             ExtraKind::Split
         } else {
@@ -259,6 +285,7 @@ impl ExtraKind {
             ExtraKind::Split => "second piece",
             ExtraKind::Wrong => "wrong action",
             ExtraKind::Spurious => "between gestures",
+            ExtraKind::Handled => "over handling",
         }
     }
 }
@@ -270,6 +297,7 @@ impl ExtraEvents {
             ExtraKind::Split => self.split += 1,
             ExtraKind::Wrong => self.wrong += 1,
             ExtraKind::Spurious => self.spurious += 1,
+            ExtraKind::Handled => self.handled += 1,
         }
     }
 }
@@ -386,6 +414,30 @@ pub fn evaluate(
     f.weight = w_ok as f64 / eff_n.max(1) as f64;
     f.state = s_ok as f64 / eff_n.max(1) as f64;
     f.confusions = conf.into_iter().map(|((a, b), c)| (a, b, c)).collect();
+    // Handling: any event is a false one.
+    for (hi, &kind) in Handling::ALL.iter().enumerate() {
+        let (mut events, mut loud) = (0, 0);
+        for k in 0..args.isolated {
+            let seed =
+                synth::sequence::item_seed(args.seed ^ HANDLING_SEED, (hi * 10_000 + k) as u64);
+            let d = synth::handled(seed, knobs, kind);
+            let evs = run_doodle(&d, &names, &blob, effort)?;
+            events += evs.len();
+            loud += usize::from(!evs.is_empty());
+            if args.verbose && !evs.is_empty() {
+                let t = super::learn::tokenize_gesture(&d.log);
+                let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
+                eprintln!(
+                    "{kind} -> {}: {}\n    played at scale {:.2} (seed {seed})",
+                    got.join(" "),
+                    super::library::tokens_to_string(&super::learn::tokens_only(&t)),
+                    d.variation.scale
+                );
+            }
+        }
+        f.handling
+            .push((kind.name().to_string(), events, loud, args.isolated));
+    }
     // Sequences.
     let (mut matched, mut n_ev, mut n_lab) = (0usize, 0usize, 0usize);
     for k in 0..args.sequences {
@@ -417,7 +469,7 @@ pub fn evaluate(
             }
         }
         for (e, _) in evs.iter().zip(&used).filter(|(_, u)| !**u) {
-            let kind = ExtraKind::of(e, &d.labels);
+            let kind = ExtraKind::of(e, &d.labels, &d.handled);
             f.extra.add(kind);
             if args.verbose {
                 let under: Vec<String> = d
@@ -537,8 +589,18 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     );
     println!(
         "  events matching no gesture: {} second pieces of a gesture, {} wrong action, {} \
-         between gestures",
-        f.extra.split, f.extra.wrong, f.extra.spurious
+         between gestures, {} over handling",
+        f.extra.split, f.extra.wrong, f.extra.spurious, f.extra.handled
+    );
+    let kinds: Vec<String> = f
+        .handling
+        .iter()
+        .map(|(k, e, l, n)| format!("{k} {e} events on {l} of {n}"))
+        .collect();
+    println!(
+        "Handling that plays no action: silent on {:.1}% ({})",
+        100.0 * f.silent(),
+        kinds.join(", ")
     );
     let (med, p90) = quantiles(&f.latencies);
     println!(
@@ -579,25 +641,35 @@ pub(crate) mod tests {
     #[test]
     fn unmatched_events_are_told_apart() {
         let labels = [label("run", 1.0, 3.0), label("jump", 4.0, 5.0)];
+        let handled = [label("lift", 6.0, 7.5)];
         assert_eq!(
-            ExtraKind::of(&ev("run", 2.2, 2.9), &labels),
+            ExtraKind::of(&ev("run", 2.2, 2.9), &labels, &handled),
             ExtraKind::Split
         );
         assert_eq!(
-            ExtraKind::of(&ev("punch", 4.5, 4.8), &labels),
+            ExtraKind::of(&ev("punch", 4.5, 4.8), &labels, &handled),
             ExtraKind::Wrong
         );
         // Over the end of the run and the start of the jump: it is a piece of the run.
         assert_eq!(
-            ExtraKind::of(&ev("run", 2.5, 4.2), &labels),
+            ExtraKind::of(&ev("run", 2.5, 4.2), &labels, &handled),
             ExtraKind::Split
         );
         assert_eq!(
-            ExtraKind::of(&ev("jump", 3.2, 3.8), &labels),
+            ExtraKind::of(&ev("jump", 3.2, 3.8), &labels, &handled),
             ExtraKind::Spurious
         );
+        assert_eq!(
+            ExtraKind::of(&ev("jump", 6.2, 7.0), &labels, &handled),
+            ExtraKind::Handled
+        );
         let mut n = ExtraEvents::default();
-        for k in [ExtraKind::Split, ExtraKind::Split, ExtraKind::Spurious] {
+        for k in [
+            ExtraKind::Split,
+            ExtraKind::Split,
+            ExtraKind::Spurious,
+            ExtraKind::Handled,
+        ] {
             n.add(k);
         }
         assert_eq!(
@@ -605,7 +677,8 @@ pub(crate) mod tests {
             ExtraEvents {
                 split: 2,
                 wrong: 0,
-                spurious: 1
+                spurious: 1,
+                handled: 1
             }
         );
     }

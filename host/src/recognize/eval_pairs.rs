@@ -26,6 +26,8 @@ pub struct PairLine {
     pub state: f64,
     /// Median decision latency, seconds.
     pub latency_s: f64,
+    /// Share of handling logs (no action played) given no event.
+    pub silent: f64,
 }
 
 impl PairLine {
@@ -38,10 +40,11 @@ impl PairLine {
             weight: f.weight,
             state: f.state,
             latency_s: quantiles(&f.latencies).0,
+            silent: f.silent(),
         }
     }
 
-    fn fields(&self) -> [f64; 6] {
+    fn fields(&self) -> [f64; 7] {
         [
             100.0 * self.isolated,
             100.0 * self.f1,
@@ -49,13 +52,14 @@ impl PairLine {
             100.0 * self.weight,
             100.0 * self.state,
             1000.0 * self.latency_s,
+            100.0 * self.silent,
         ]
     }
 }
 
 /// Per field: mean, smallest, largest over `lines` (percent, latency in ms).
-pub fn summarise(lines: &[PairLine]) -> [(f64, f64, f64); 6] {
-    let mut out = [(0.0, f64::INFINITY, f64::NEG_INFINITY); 6];
+pub fn summarise(lines: &[PairLine]) -> [(f64, f64, f64); 7] {
+    let mut out = [(0.0, f64::INFINITY, f64::NEG_INFINITY); 7];
     for l in lines {
         for (o, v) in out.iter_mut().zip(l.fields()) {
             o.0 += v / lines.len() as f64;
@@ -68,8 +72,8 @@ pub fn summarise(lines: &[PairLine]) -> [(f64, f64, f64); 6] {
 
 fn header() {
     println!(
-        "{:>5} {:>6} {:>6}  {:>8} {:>6} {:>6} {:>6} {:>6} {:>8}",
-        "pair", "train", "test", "isolated", "F1", "Time", "Weight", "state", "latency"
+        "{:>5} {:>6} {:>6}  {:>8} {:>6} {:>6} {:>6} {:>6} {:>8} {:>6}",
+        "pair", "train", "test", "isolated", "F1", "Time", "Weight", "state", "latency", "silent"
     );
 }
 
@@ -112,7 +116,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     for (k, ((train, test), l)) in rows.iter().zip(&lines).enumerate() {
         let v = l.fields();
         println!(
-            "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms",
+            "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms {:>5.1}%",
             k + 1,
             train,
             test,
@@ -121,17 +125,18 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             v[2],
             v[3],
             v[4],
-            v[5]
+            v[5],
+            v[6]
         );
     }
     let s = summarise(&lines);
     println!(
-        "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms",
-        "mean", "", "", s[0].0, s[1].0, s[2].0, s[3].0, s[4].0, s[5].0
+        "{:>5} {:>6} {:>6}  {:>7.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.1}% {:>5.0} ms {:>5.1}%",
+        "mean", "", "", s[0].0, s[1].0, s[2].0, s[3].0, s[4].0, s[5].0, s[6].0
     );
     println!(
         "range: isolated {:.1}–{:.1}%, F1 {:.1}–{:.1}%, Time {:.1}–{:.1}%, Weight {:.1}–{:.1}%, \
-         state {:.1}–{:.1}%, latency {:.0}–{:.0} ms",
+         state {:.1}–{:.1}%, latency {:.0}–{:.0} ms, silent {:.1}–{:.1}%",
         s[0].1,
         s[0].2,
         s[1].1,
@@ -143,7 +148,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         s[4].1,
         s[4].2,
         s[5].1,
-        s[5].2
+        s[5].2,
+        s[6].1,
+        s[6].2
     );
     Ok(())
 }
@@ -161,6 +168,7 @@ mod tests {
             weight: 0.85,
             state: 0.75,
             latency_s: 0.140,
+            silent: 1.0,
         };
         let b = PairLine {
             isolated: 0.9,
@@ -169,6 +177,7 @@ mod tests {
             weight: 0.95,
             state: 0.85,
             latency_s: 0.160,
+            silent: 0.9,
         };
         let s = summarise(&[a, b]);
         let close = |x: f64, y: f64| (x - y).abs() < 1e-9;
@@ -176,5 +185,6 @@ mod tests {
         assert!(close(s[1].0, 75.0));
         assert!(close(s[2].1, 80.0) && close(s[2].2, 90.0));
         assert!(close(s[5].0, 150.0) && close(s[5].1, 140.0) && close(s[5].2, 160.0));
+        assert!(close(s[6].0, 95.0) && close(s[6].1, 90.0));
     }
 }

@@ -241,6 +241,10 @@ struct KnobArgs {
     /// backward timestamp [default: 0].
     #[arg(long)]
     glitch: Option<Range>,
+    /// Probability that a sequence also holds one handling of the toy that plays no action:
+    /// carried elsewhere, or lifted and set down [default: 0.333].
+    #[arg(long)]
+    handling: Option<f64>,
     /// A perfect tracker: no noise, tremor, drift, jitter, drops or glitches (overrides those).
     #[arg(long)]
     clean: bool,
@@ -265,6 +269,7 @@ impl KnobArgs {
             pause_s: self.pause.unwrap_or(d.pause_s),
             sign: self.quat_sign,
             glitch: self.glitch.unwrap_or(d.glitch),
+            handling: self.handling.unwrap_or(d.handling),
         };
         if self.clean {
             k.noise = Range::fixed(0.0);

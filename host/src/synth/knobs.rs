@@ -111,6 +111,9 @@ pub struct Knobs {
     /// Probability per sample of a tracker glitch (spike, NaN row, zero quaternion, repeated or
     /// backward timestamp); default 0 (see [`super::noise::Glitcher`]).
     pub glitch: Range,
+    /// Probability that a sequence also holds one handling of the toy that plays no action
+    /// (carried elsewhere, lifted and set down: [`super::Handling`]); default 1/3.
+    pub handling: f64,
 }
 
 impl Default for Knobs {
@@ -131,13 +134,15 @@ impl Default for Knobs {
             pause_s: Range::new(0.3, 1.5),
             sign: None,
             glitch: Range::fixed(0.0),
+            handling: 1.0 / 3.0,
         }
     }
 }
 
 impl Knobs {
     /// Knobs with no sensor imperfections, fixed rate, no jitter or drops, unit scale and speed,
-    /// heading 0, no tilt, start at (0, 1, 0), clock from 0: the canonical doodle, for tests.
+    /// heading 0, no tilt, start at (0, 1, 0), clock from 0, no handling: the canonical doodle,
+    /// for tests.
     pub fn canonical() -> Self {
         Self {
             rate_hz: Range::fixed(120.0),
@@ -155,6 +160,7 @@ impl Knobs {
             pause_s: Range::fixed(0.5),
             sign: Some(SignMode::Continuous),
             glitch: Range::fixed(0.0),
+            handling: 0.0,
         }
     }
 
@@ -217,6 +223,7 @@ impl Knobs {
         check("lead", self.lead_s, 0.0, 60.0)?;
         check("pause", self.pause_s, 0.0, 60.0)?;
         check("glitch", self.glitch, 0.0, 0.5)?;
+        check("handling", Range::fixed(self.handling), 0.0, 1.0)?;
         Ok(())
     }
 }

@@ -23,7 +23,9 @@
 //! seen; at 30 Hz Weight shows mostly through amplitude and speed.
 //!
 //! [`rest`] makes logs of a figurine that plays *no* action — held in a hand, set on a table,
-//! or mounted on a stand — under a chosen tracker level, for false-positive checks.
+//! or mounted on a stand — under a chosen tracker level, for false-positive checks;
+//! [`handling`] moves it as far as an action does without playing one (carried elsewhere,
+//! lifted and set down).
 //!
 //! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot|rest` (see
 //! [`cli`]). Library use (in-process, no files):
@@ -37,6 +39,7 @@
 pub mod cli;
 pub mod effort;
 pub mod gesture;
+pub mod handling;
 pub mod knobs;
 pub mod noise;
 pub mod plot;
@@ -49,6 +52,9 @@ pub mod trajectory;
 
 pub use effort::{Effort, TimeClass, WeightClass};
 pub use gesture::Action;
+pub use handling::Handling;
 pub use knobs::{Knobs, Range, Variation};
 pub use rest::{rest_log, RestKind, RestLog, RestSpec, TrackerLevel, TRACKER_LEVELS};
-pub use sequence::{effort_set, examples, gesture, render, sequence, Doodle, Label, Performer};
+pub use sequence::{
+    effort_set, examples, gesture, handled, render, sequence, Doodle, Label, Performer,
+};

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use super::effort::{Effort, TimeClass, WeightClass};
 use super::gesture::{plan, Action};
+use super::handling::{self, Handling};
 use super::knobs::{Knobs, Variation};
 use super::noise::{Glitcher, SensorModel};
 use super::rng::{Stream, SynthRng};
@@ -42,6 +43,9 @@ pub struct Doodle {
     pub log: PoseLog,
     /// One label per performed action, in time order.
     pub labels: Vec<Label>,
+    /// Spans of handling that plays no action ([`Performer::handle`]), named by its kind, in
+    /// time order: any event over one is a false one.
+    pub handled: Vec<Label>,
     /// The drawn nuisance parameters.
     pub variation: Variation,
     /// The master seed.
@@ -63,6 +67,9 @@ impl Doodle {
                 "# label {} {:.6}..{:.6} {:?}/{:?}",
                 l.action, l.start, l.end, l.time_class, l.weight_class
             )?;
+        }
+        for h in &self.handled {
+            writeln!(w, "# handled {} {:.6}..{:.6}", h.action, h.start, h.end)?;
         }
         self.log.write(&mut w)?;
         w.flush()
@@ -89,6 +96,7 @@ pub struct Performer<'k> {
     rng: SynthRng,
     traj: Trajectory,
     labels: Vec<Label>,
+    handled: Vec<Label>,
 }
 
 impl<'k> Performer<'k> {
@@ -111,6 +119,7 @@ impl<'k> Performer<'k> {
             rng,
             traj,
             labels: Vec::new(),
+            handled: Vec::new(),
         }
     }
 
@@ -140,6 +149,28 @@ impl<'k> Performer<'k> {
         self.traj.push(Stroke::hold(pause));
     }
 
+    /// Handles the toy without playing an action ([`Handling`]), records its span, and pauses;
+    /// its strokes and pause are drawn from `rng`, so the actions around it are drawn as they
+    /// would be without it.
+    pub fn handle(&mut self, kind: Handling, rng: &mut SynthRng) {
+        let strokes = handling::plan(kind, self.var.scale, rng);
+        let start = self.traj.end();
+        let speed = self.var.speed;
+        self.traj.extend(strokes.into_iter().map(|mut s| {
+            s.duration /= speed;
+            s
+        }));
+        self.handled.push(Label {
+            action: kind.name().to_string(),
+            start: to_micros(start),
+            end: to_micros(self.traj.end()),
+            time_class: TimeClass::Neutral,
+            weight_class: WeightClass::Neutral,
+        });
+        let pause = self.knobs.pause_s.draw(rng).max(0.05);
+        self.traj.push(Stroke::hold(pause));
+    }
+
     /// Samples the performed trajectory through the tracker model.
     pub fn finish(self) -> Doodle {
         let Self {
@@ -147,6 +178,7 @@ impl<'k> Performer<'k> {
             var,
             traj,
             labels,
+            handled,
             ..
         } = self;
         let mut sensor_rng = SynthRng::new(seed, Stream::Sensor);
@@ -184,6 +216,7 @@ impl<'k> Performer<'k> {
         Doodle {
             log: PoseLog { samples },
             labels,
+            handled,
             variation: var,
             seed,
         }
@@ -204,21 +237,50 @@ pub fn gesture(seed: u64, knobs: &Knobs, action: Action, effort: Effort) -> Dood
     render(seed, knobs, &[(action, effort)])
 }
 
+/// One handling of `kind` ([`Handling`]) alone, between still pauses: a log with no action.
+pub fn handled(seed: u64, knobs: &Knobs, kind: Handling) -> Doodle {
+    let mut p = Performer::new(seed, knobs);
+    p.handle(
+        kind,
+        &mut SynthRng::child(seed, Stream::Plan, HANDLING_STREAM),
+    );
+    p.finish()
+}
+
 /// Horizontal distance (metres) beyond the room's half-size at which a figurine facing away
 /// from the room's centre is turned back before travelling further.
 const ROOM_MARGIN_M: f64 = 0.3;
 
+/// Index of the child stream handling is drawn from, apart from the actions'.
+const HANDLING_STREAM: u64 = 0x4a4d;
+
 /// A sequence of `count` random actions, each with a random one of the four effort states
 /// (or `effort` for all), separated by still pauses. Like a child keeping the toy on the table,
 /// a figurine that has wandered out of the room (see [`Knobs::room_m`]) and faces away from its
-/// centre turns (a labelled `turn`) instead of travelling further.
+/// centre turns (a labelled `turn`) instead of travelling further. With probability
+/// [`Knobs::handling`] the child also handles the toy once, at a random place in the sequence,
+/// without playing an action ([`Handling`], recorded in [`Doodle::handled`]); the actions are
+/// drawn the same either way.
 pub fn sequence(seed: u64, knobs: &Knobs, count: usize, effort: Option<Effort>) -> Doodle {
     let mut pick = SynthRng::child(seed, Stream::Plan, 0x5e9);
+    let mut aside = SynthRng::child(seed, Stream::Plan, HANDLING_STREAM);
+    let handle_at = aside.chance(knobs.handling).then(|| {
+        (
+            aside.index(count + 1),
+            Handling::ALL[aside.index(Handling::ALL.len())],
+        )
+    });
     let mut p = Performer::new(seed, knobs);
+    let mut handle = |p: &mut Performer<'_>, i: usize| {
+        if let Some((_, kind)) = handle_at.filter(|&(at, _)| at == i) {
+            p.handle(kind, &mut aside);
+        }
+    };
     let mid = (knobs.room_m.lo + knobs.room_m.hi) / 2.0;
     let centre = DVec3::new(mid, 0.0, mid);
     let limit = ((knobs.room_m.hi - knobs.room_m.lo) / 2.0).max(0.5) + ROOM_MARGIN_M;
-    for _ in 0..count {
+    for i in 0..count {
+        handle(&mut p, i);
         let mut action = Action::ALL[pick.index(Action::ALL.len())];
         let e = effort.unwrap_or(Effort::random_state(&mut pick));
         let st = p.state();
@@ -229,6 +291,7 @@ pub fn sequence(seed: u64, knobs: &Knobs, count: usize, effort: Option<Effort>) 
         }
         p.perform(action, e);
     }
+    handle(&mut p, count);
     p.finish()
 }
 
