@@ -7,9 +7,10 @@ use figurine_host::synth::sequence::item_seed;
 use figurine_host::synth::{handled, sequence, Handling, Knobs};
 use figurine_recognizer::EffortModel;
 
-/// Lifts at the generator's every scale, tempo, rate and noise: up, a look, down. Each strays
-/// from every action's pattern and moves like none of their examples, so none may be read as
-/// the action its tokens happen to come nearest (before, nearly all were: a throw, a walk).
+/// Lifts at the generator's every scale, tempo, rate and noise: up, a look, down. A lift that
+/// strays from every action's pattern and moves like none of their examples is not read as the
+/// action its tokens happen to come nearest (before, nearly all were: a throw, a walk), and
+/// one that spells a jump's `u d` is no jump, for it comes down where it rose.
 #[test]
 fn a_toy_lifted_and_set_down_is_no_action() {
     let b = blobs::load(None, None).expect("shipped library and effort model");
@@ -27,8 +28,9 @@ fn a_toy_lifted_and_set_down_is_no_action() {
             loud.push(format!("seed {seed}: {}", r.action));
         }
     }
-    // Some still spell a jump closely enough (`u d`, a jump straight up: 7 of these 20).
-    assert!(loud.len() as u64 <= LIFTS / 2, "{loud:?}");
+    // One is still read as a crouch (`u d` done upside down). Before a jump had to travel as
+    // its examples did, 7 of these 20 were jumps: up and down, landing where they rose.
+    assert!(loud.len() as u64 <= LIFTS / 10, "{loud:?}");
 }
 
 /// A sequence may hold one handling between its actions; the actions are drawn as they would

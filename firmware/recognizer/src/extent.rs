@@ -14,7 +14,12 @@
 //! |---|---|---|
 //! | [`Extent::moved_m`] | farthest world displacement from where the phrase began | m |
 //! | [`Extent::turned_rad`] | farthest rotation from where it began (\|Σ ω·dt\| about the object's axes) | rad |
+//! | [`Extent::travel_m`] | how far from where it began it ended, across the floor | m |
 //! | carries | a dimension whose least extent, rotation weighed by [`ARM_M`], is at least [`CARRY_SHARE`] of the other's | — |
+//!
+//! An action whose every example travelled — a jump lands ahead of where it took off, a walk
+//! ends elsewhere — is held to its travel too, as to a dimension that carries it: a toy lifted
+//! and set back down where it was goes up and down as a jump does, but goes nowhere.
 //!
 //! The farthest point, not the path: tracker noise lengthens a path without end, but moves
 //! the figurine only as far as the noise's own size. It is read at the ends of token runs,
@@ -63,6 +68,8 @@ pub struct Extent {
     pub moved_m: f32,
     /// Farthest rotation from the start, rad.
     pub turned_rad: f32,
+    /// Horizontal distance from the start to the end, m.
+    pub travel_m: f32,
 }
 
 /// Running sums over consecutive runs ([`Accum::moved`], [`Accum::turned`]) and the farthest
@@ -83,6 +90,7 @@ impl ExtentSums {
             far: Extent {
                 moved_m: 0.0,
                 turned_rad: 0.0,
+                travel_m: 0.0,
             },
         }
     }
@@ -98,9 +106,13 @@ impl ExtentSums {
         self.far.turned_rad = fmath::max(self.far.turned_rad, norm(self.turned) * TURNED_UNIT_RAD);
     }
 
-    /// How far the runs added went.
+    /// How far the runs added went, and where they ended.
     pub fn extent(&self) -> Extent {
-        self.far
+        let [x, _, z] = self.moved.map(|v| v as f32 * MOVED_UNIT_M);
+        Extent {
+            travel_m: fmath::sqrt(x * x + z * z),
+            ..self.far
+        }
     }
 }
 
@@ -115,7 +127,9 @@ pub fn span_extent(hist: &History, from: u32, to: u32) -> Extent {
 
 /// Whether motion that went `went` went far enough to be an action whose least example went
 /// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
-/// in a dimension that carries the action.
+/// in a dimension that carries the action, and as far across the floor when moving carries
+/// it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved, and
+/// farther than a fidget).
 pub fn far_enough(went: Extent, least: Extent) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
@@ -127,8 +141,20 @@ pub fn far_enough(went: Extent, least: Extent) -> bool {
         fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD),
         FIDGET_TURNED_RAD,
     );
-    (moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
-        || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned)
+    // Travel is part of moving: it carries an action that moving carries, when its examples
+    // ended at least that share as far off as they went (a turn's grip swings the tracked
+    // point aside, but the turn is carried by its rotation) and farther than a fidget.
+    let travels = moved >= CARRY_SHARE * turned
+        && least.travel_m >= CARRY_SHARE * moved
+        && least.travel_m > FIDGET_MOVED_M;
+    let need_travel = if travels {
+        fmath::min(ACCEPT_SHARE * least.travel_m, ENOUGH_MOVED_M)
+    } else {
+        0.0
+    };
+    went.travel_m >= need_travel
+        && ((moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
+            || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned))
 }
 
 /// A learnt extent `x` (in the code's `unit`) as the library's byte: 1 + 16·log2(x / unit),
@@ -156,6 +182,7 @@ mod tests {
         Extent {
             moved_m,
             turned_rad,
+            travel_m: 0.0,
         }
     }
 
@@ -240,6 +267,51 @@ mod tests {
         // Examples that went nowhere admit anything that goes farther than a fidget.
         assert!(far_enough(ext(0.012, 0.0), Extent::default()));
         assert!(!far_enough(Extent::default(), Extent::default()));
+    }
+
+    #[test]
+    fn an_action_whose_examples_all_travelled_must_travel() {
+        // A jump's least example: 25 cm from the start at the top, landing 15 cm ahead.
+        let jump = Extent {
+            travel_m: 0.15,
+            ..ext(0.25, 0.2)
+        };
+        // A toy lifted 10 cm and set down where it was: as high, but nowhere.
+        let lift = Extent {
+            travel_m: 0.004,
+            ..ext(0.1, 0.1)
+        };
+        assert!(!far_enough(lift, jump));
+        // A small jump that landed a few centimetres ahead is one.
+        let small = Extent {
+            travel_m: 0.03,
+            ..ext(0.08, 0.05)
+        };
+        assert!(far_enough(small, jump));
+        // A crouch's examples came back where they started: its travel carries nothing.
+        let crouch = Extent {
+            travel_m: 0.01,
+            ..ext(0.1, 0.1)
+        };
+        assert!(far_enough(lift, crouch));
+        // Nor does a turn's, carried by its rotation, though the grip swung it 5 cm aside.
+        let turn = Extent {
+            travel_m: 0.05,
+            ..ext(0.05, 1.6)
+        };
+        assert!(far_enough(ext(0.0, 1.0), turn));
+    }
+
+    #[test]
+    fn the_travel_is_where_the_runs_ended_across_the_floor() {
+        // Up 10 cm, 3 cm ahead, and down again: the farthest point 10.4 cm, the travel 3 cm.
+        let mut s = ExtentSums::new();
+        for t in [[0.0, 0.01, 0.003], [0.0, -0.01, 0.0]] {
+            s.add(&run(10, moving(t)));
+        }
+        let e = s.extent();
+        assert!((e.travel_m - 0.03).abs() < 1e-4, "{e:?}");
+        assert!((e.moved_m - libm::hypotf(0.1, 0.03)).abs() < 1e-4, "{e:?}");
     }
 
     #[test]

@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (7; version 6, whose shape table has only the first 15
-//!         bytes of each entry, is still read and its holds are not known; version 5, with
+//! 0   4   magic "FGL" + version byte (8; version 7, whose shape table has only the first 16
+//!         bytes of each entry, is still read and its travels are not known; version 6, with
+//!         only 15, is still read and its holds are not known either; version 5, with
 //!         only 13, is still read and its extents are not known either; versions 4, 3 and
 //!         2, with only 7, 6 and 4 bytes, and version 1, without the table, are still read —
 //!         their shapes are not used)
@@ -27,7 +28,7 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 16 bytes per action in record order (the mean of its examples'
+//! then the shape table, 17 bytes per action in record order (the mean of its examples'
 //! shapes, `features::Shape`, how far they lay from it, how far the least of them went and
 //! how long they held still inside):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
@@ -46,6 +47,8 @@
 //!         0 = not known (both are known or neither)
 //! +15 1   the longest stillness inside an example (between its first and last motion), in
 //!         [`HOLD_UNIT_US`]; 0 = none or not known
+//! +16 1   the least travel among the examples (how far across the floor from where each
+//!         began it ended), code in `extent::MOVED_CODE_UNIT_M`; 0 = not known
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -63,9 +66,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 7;
+pub const LIBRARY_VERSION: u8 = 8;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 16;
+pub const SHAPE_BYTES: usize = 17;
+/// Bytes per action in a version 7 shape table (no travel).
+const SHAPE_BYTES_V7: usize = 16;
+/// Offset of the travel in a shape-table entry.
+const SHAPE_TRAVEL_AT: usize = 16;
 /// Bytes per action in a version 6 shape table (no hold).
 const SHAPE_BYTES_V6: usize = 15;
 /// Offset of the hold in a shape-table entry.
@@ -92,7 +99,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,168).
+/// Largest valid library blob, bytes (12,200).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -247,7 +254,7 @@ pub struct Library<'a> {
     /// Offset of the shape table (0: none — a version 1 blob, or a version 2, 3 or 4 one,
     /// whose shapes lack dimensions or tolerances and are not used).
     shapes: u16,
-    /// Bytes per entry of the shape table ([`SHAPE_BYTES`], or a version 5 table's 13).
+    /// Bytes per entry of the shape table ([`SHAPE_BYTES`], or an older version's fewer).
     stride: u8,
 }
 
@@ -305,6 +312,7 @@ impl<'a> Library<'a> {
             4 => SHAPE_BYTES_V4,
             5 => SHAPE_BYTES_V5,
             6 => SHAPE_BYTES_V6,
+            7 => SHAPE_BYTES_V7,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -376,16 +384,27 @@ impl<'a> Library<'a> {
     }
 
     /// How far the least of action `i`'s examples went ([`crate::extent`]); None when not
-    /// learnt (a version 5 library, or an action learnt without examples).
+    /// learnt (a version 5 library, or an action learnt without examples). Its travel is 0
+    /// when not known (a version 7 library).
     pub fn extent(&self, i: usize) -> Option<Extent> {
         if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES_V6 {
             return None;
         }
-        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_EXTENT_AT;
+        let entry = usize::from(self.shapes) + usize::from(self.stride) * i;
+        let at = entry + SHAPE_EXTENT_AT;
+        let travel = if usize::from(self.stride) > SHAPE_TRAVEL_AT {
+            self.bytes
+                .get(entry + SHAPE_TRAVEL_AT)
+                .copied()
+                .unwrap_or(0)
+        } else {
+            0
+        };
         match *self.bytes.get(at..at + 2)? {
             [m, t] => Some(Extent {
                 moved_m: from_byte(m, MOVED_CODE_UNIT_M)?,
                 turned_rad: from_byte(t, TURNED_CODE_UNIT_RAD)?,
+                travel_m: from_byte(travel, MOVED_CODE_UNIT_M).unwrap_or(0.0),
             }),
             _ => None,
         }
@@ -395,10 +414,10 @@ impl<'a> Library<'a> {
     /// of it may hold still and go on (0 when its examples never held, or not learnt: a
     /// library older than version 7).
     pub fn hold_us(&self, i: usize) -> u64 {
-        if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_HOLD_AT {
             return 0;
         }
-        let at = usize::from(self.shapes) + SHAPE_BYTES * i + SHAPE_HOLD_AT;
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_HOLD_AT;
         self.bytes
             .get(at)
             .map_or(0, |&b| u64::from(b) * HOLD_UNIT_US)
@@ -601,7 +620,7 @@ pub(crate) mod tests {
                 Some([l, u, f, t, st, h]) => {
                     out.extend([*l, *u, *f, 1, *t, *st, *h]);
                     out.extend([0; SHAPE_DIMS]);
-                    out.extend([0; 3]);
+                    out.extend([0; 4]);
                 }
                 None => out.extend([0; SHAPE_BYTES]),
             }
@@ -622,6 +641,7 @@ pub(crate) mod tests {
             out.extend([
                 to_byte(m, MOVED_CODE_UNIT_M),
                 to_byte(t, TURNED_CODE_UNIT_RAD),
+                0,
                 0,
             ]);
         }
@@ -740,6 +760,24 @@ pub(crate) mod tests {
             (lib.hold_us(0), lib.hold_us(1), lib.hold_us(2)),
             (920_000, 0, 0)
         );
+        // Version 7: sixteen bytes per entry, the hold without the travel.
+        let mut v7 = v1.clone();
+        v7[3] = 7;
+        let held_entry = &held[entry..entry + SHAPE_BYTES_V7];
+        v7.extend(held_entry);
+        v7.extend([0; SHAPE_BYTES_V7]);
+        let lib = Library::from_bytes(&v7).unwrap();
+        assert_eq!((lib.hold_us(0), lib.hold_us(1)), (920_000, 0));
+        assert!(near(lib.shape(0), want));
+        // The travel, in the moved extent's code; 0 when not known.
+        let mut ext = held.clone();
+        ext[entry + 13] = 1 + 16 * 10;
+        ext[entry + 14] = 1 + 16 * 5;
+        assert_eq!(lib_extent(&ext).map(|e| e.travel_m), Some(0.0));
+        ext[entry + SHAPE_TRAVEL_AT] = 1 + 16 * 9;
+        let e = lib_extent(&ext).unwrap();
+        assert!((e.travel_m - 0.0512).abs() < 1e-5, "{e:?}");
+        assert_eq!(Library::from_bytes(&ext).unwrap().hold_us(0), 920_000);
         // The extents, both known or neither.
         assert_eq!(lib_extent(&tol), None);
         let mut ext = tol.clone();

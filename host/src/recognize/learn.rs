@@ -166,6 +166,7 @@ pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
         .reduce(|a, b| Extent {
             moved_m: a.moved_m.min(b.moved_m),
             turned_rad: a.turned_rad.min(b.turned_rad),
+            travel_m: a.travel_m.min(b.travel_m),
         })
 }
 

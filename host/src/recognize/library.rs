@@ -76,6 +76,12 @@ pub struct ActionEntry {
     /// action; absent for a pattern written by hand or learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extent: Option<[f32; 2]>,
+    /// How far across the floor from where it began the least travelled example ended, m
+    /// (`figurine_recognizer::extent`): an action whose every example travelled (a jump, a
+    /// walk) is reported only for motion that travels a share of that too; absent for a
+    /// pattern written by hand or learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub travel_m: Option<f32>,
     /// The longest stillness inside any example, between its first and last motion, s: how
     /// long a performance may hold and go on (a crouch held low, then risen from). The device
     /// keeps the event open for a continuation that long; absent when no example held, for a
@@ -168,6 +174,7 @@ impl ActionEntry {
             shape_tolerance: None,
             shape_spread: None,
             extent: None,
+            travel_m: None,
             hold_s: None,
         };
         let c = Regex::parse(regex)?.compile()?;
@@ -212,6 +219,7 @@ impl ActionEntry {
     /// The same entry with the examples' least extent `extent` (see [`ActionEntry::extent`]).
     pub fn with_extent(mut self, extent: Option<Extent>) -> Self {
         self.extent = extent.map(|e| [e.moved_m, e.turned_rad]);
+        self.travel_m = extent.map(|e| e.travel_m);
         self
     }
 
@@ -252,6 +260,9 @@ impl ActionEntry {
                     extent.map_or(0, |e| to_byte(e[0], MOVED_CODE_UNIT_M)),
                     extent.map_or(0, |e| to_byte(e[1], TURNED_CODE_UNIT_RAD)),
                     duration_byte(self.hold_s),
+                    self.travel_m
+                        .filter(|t| t.is_finite() && extent.is_some())
+                        .map_or(0, |t| to_byte(t, MOVED_CODE_UNIT_M)),
                 ]
             }
             _ => [0; SHAPE_BYTES],
