@@ -61,3 +61,48 @@ fn a_sequence_holds_handling_apart_from_its_actions() {
         }
     }
 }
+
+/// `figurine synth handling` writes a log whose span is marked, which `simulate` reads as
+/// nothing; an unknown kind is a clear error.
+#[test]
+fn the_command_line_writes_handling_that_reads_as_nothing() {
+    let dir = std::env::temp_dir().join(format!("figurine-handling-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("lift.csv");
+    let fig = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_figurine"))
+            .args(args)
+            .env("RUST_BACKTRACE", "0")
+            .output()
+            .unwrap()
+    };
+    let path = log.to_str().unwrap();
+    let out = fig(&[
+        "synth", "handling", "--kind", "lift", "--seed", "3", "--out", path,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        text.lines().any(|l| l.starts_with("# handled lift ")),
+        "{text}"
+    );
+    let out = fig(&["simulate", "--jsonl", path]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        !String::from_utf8_lossy(&out.stdout).contains("\"action\""),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let out = fig(&["synth", "handling", "--kind", "wave", "--out", path]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("known: reposition, lift"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -7,10 +7,13 @@ use clap::{Args, Subcommand};
 
 use super::effort::Effort;
 use super::gesture::Action;
+use super::handling::Handling;
 use super::knobs::{Knobs, Range};
 use super::rest::{rest_log, RestKind, RestSpec, TrackerLevel};
 use super::sampling::SignMode;
-use super::sequence::{effort_set, examples, gesture, random_state_for, render, sequence, Doodle};
+use super::sequence::{
+    effort_set, examples, gesture, handled, random_state_for, render, sequence, Doodle,
+};
 
 /// Most actions in one `sequence` log (≈ 2–3 s each; 10 000 actions at 240 Hz ≈ 6 M samples,
 /// ≈ 400 MB in memory).
@@ -46,6 +49,21 @@ enum SynthCommand {
         /// Also write the label as a one-element JSON array here.
         #[arg(long)]
         labels: Option<PathBuf>,
+        #[command(flatten)]
+        knobs: KnobArgs,
+    },
+    /// The toy handled without playing an action: carried elsewhere, or lifted, looked at and
+    /// set back down (any event on it is a false one).
+    Handling {
+        /// Kind: reposition or lift.
+        #[arg(long)]
+        kind: Handling,
+        /// Master seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output pose log (CSV; the handling's span in a `# handled` line).
+        #[arg(long)]
+        out: PathBuf,
         #[command(flatten)]
         knobs: KnobArgs,
     },
@@ -324,6 +342,13 @@ fn summary(d: &Doodle, out: &Path) {
     if d.labels.len() > SUMMARY_LABELS {
         let _ = writeln!(w, "  … {} more", d.labels.len() - SUMMARY_LABELS);
     }
+    for h in &d.handled {
+        let _ = writeln!(
+            w,
+            "  {:<9} {:>9.3} .. {:>9.3} s  (handled, no action)",
+            h.action, h.start, h.end
+        );
+    }
 }
 
 /// Prints one line, ignoring a closed pipe.
@@ -353,6 +378,16 @@ pub fn run(args: SynthArgs) -> Result<()> {
                 d.write_labels(&l)
                     .with_context(|| format!("writing {}", l.display()))?;
             }
+            summary(&d, &out);
+        }
+        SynthCommand::Handling {
+            kind,
+            seed,
+            out,
+            knobs,
+        } => {
+            let d = handled(seed, &knobs.knobs()?, kind);
+            write_doodle(&d, &out)?;
             summary(&d, &out);
         }
         SynthCommand::Sequence {

@@ -27,8 +27,9 @@
 //! [`handling`] moves it as far as an action does without playing one (carried elsewhere,
 //! lifted and set down).
 //!
-//! Command line: `figurine synth gesture|sequence|effort-set|examples|gallery|plot|rest` (see
-//! [`cli`]). Library use (in-process, no files):
+//! Command line: `figurine synth
+//! gesture|sequence|handling|effort-set|examples|gallery|plot|rest` (see [`cli`]). Library use
+//! (in-process, no files):
 //! ```
 //! use figurine_host::synth::{gesture, Action, Effort, Knobs};
 //! let d = gesture(7, &Knobs::default(), Action::Jump, "sudden-strong".parse().unwrap());
