@@ -132,6 +132,15 @@ fn label_colour(l: &Label) -> Rgb<u8> {
 
 /// Draws the four panels of `log` with optional `labels`.
 pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
+    plot_with_handling(log, labels, &[])
+}
+
+/// Grey of a span of handling that plays no action.
+const HANDLED_GREY: Rgb<u8> = Rgb([225, 225, 225]);
+
+/// Draws the four panels of `log` with `labels`, and `handled` spans (handling that plays no
+/// action, [`super::Handling`]) shaded grey and captioned as no action.
+pub fn plot_with_handling(log: &PoseLog, labels: &[Label], handled: &[Label]) -> RgbImage {
     let mut c = Canvas {
         img: RgbImage::from_pixel(WIDTH, HEIGHT, Rgb([255, 255, 255])),
     };
@@ -179,8 +188,11 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
         _ => (0.0, 1.0),
     };
     let tx = |p: Panel, t: f64| p.x0 + (t - t_lo) / (t_hi - t_lo) * p.w;
-    for l in labels {
-        let col = label_colour(l);
+    let shaded = labels
+        .iter()
+        .map(|l| (l, label_colour(l)))
+        .chain(handled.iter().map(|h| (h, HANDLED_GREY)));
+    for (l, col) in shaded {
         c.fill_cols(speed, tx(speed, l.start), tx(speed, l.end), col);
         c.fill_cols(orient, tx(orient, l.start), tx(orient, l.end), col);
     }
@@ -197,6 +209,18 @@ pub fn plot(log: &PoseLog, labels: &[Label]) -> RgbImage {
         );
         draw_text(&mut c.img, x as i64, speed.y0 as i64 + 4, &l.action, 2, ink);
         draw_text(&mut c.img, x as i64, speed.y0 as i64 + 22, &effort, 1, ink);
+    }
+    for h in handled {
+        let x = tx(speed, h.start) + 3.0;
+        draw_text(&mut c.img, x as i64, speed.y0 as i64 + 4, &h.action, 2, ink);
+        draw_text(
+            &mut c.img,
+            x as i64,
+            speed.y0 as i64 + 22,
+            "NO ACTION",
+            1,
+            ink,
+        );
     }
     let mut captions: Vec<(Panel, String, bool)> = vec![
         (top, "TOP VIEW X-Z, BLUE TO RED".into(), false),
@@ -423,9 +447,33 @@ fn short_weight(w: WeightClass) -> &'static str {
     }
 }
 
-/// Reads a pose log (and labels JSON), plots it, and writes the PNG.
+/// The handled spans a generated log records in its `# handled KIND START..END` lines (see
+/// [`super::Doodle::write_csv`]); other lines, and malformed ones, are skipped.
+pub fn handled_spans(text: &str) -> Vec<Label> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("# handled "))
+        .filter_map(|rest| {
+            let (kind, span) = rest.trim().split_once(' ')?;
+            let (a, b) = span.split_once("..")?;
+            let (start, end) = (a.trim().parse().ok()?, b.trim().parse().ok()?);
+            Some(Label {
+                action: kind.to_string(),
+                start,
+                end,
+                time_class: TimeClass::Neutral,
+                weight_class: WeightClass::Neutral,
+            })
+        })
+        .collect()
+}
+
+/// Reads a pose log (and labels JSON), plots it with the handling it records, and writes the
+/// PNG.
 pub fn plot_files(log: &Path, labels: Option<&Path>, out: &Path) -> Result<()> {
     let pl = PoseLog::read_path(log)?;
+    let handled = std::fs::read_to_string(log)
+        .map(|t| handled_spans(&t))
+        .unwrap_or_default();
     let labels: Vec<Label> = match labels {
         Some(p) => {
             let text =
@@ -434,7 +482,38 @@ pub fn plot_files(log: &Path, labels: Option<&Path>, out: &Path) -> Result<()> {
         }
         None => Vec::new(),
     };
-    plot(&pl, &labels)
+    plot_with_handling(&pl, &labels, &handled)
         .save(out)
         .with_context(|| format!("writing {}", out.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::{sequence, Knobs};
+
+    #[test]
+    fn handled_spans_come_back_from_a_written_log_and_are_shaded() {
+        let knobs = Knobs {
+            handling: 1.0,
+            ..Knobs::default()
+        };
+        let d = sequence(5, &knobs, 2, None);
+        let path = std::env::temp_dir().join(format!("figurine-plot-{}.csv", std::process::id()));
+        d.write_csv(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        let spans = handled_spans(&text);
+        assert_eq!(spans.len(), 1);
+        assert_eq!(spans[0].action, d.handled[0].action);
+        assert!((spans[0].start - d.handled[0].start).abs() < 1e-6);
+        assert!((spans[0].end - d.handled[0].end).abs() < 1e-6);
+        // Malformed lines are skipped.
+        assert!(handled_spans("# handled lift\n# handled lift a..b\n").is_empty());
+        // The span is shaded grey in the speed panel, where nothing else is.
+        let bare = plot(&d.log, &d.labels);
+        let shaded = plot_with_handling(&d.log, &d.labels, &spans);
+        let greys = |img: &RgbImage| img.pixels().filter(|p| **p == HANDLED_GREY).count();
+        assert!(greys(&shaded) > greys(&bare) + 1000);
+    }
 }
