@@ -260,7 +260,8 @@ const HANDLING_STREAM: u64 = 0x4a4d;
 /// centre turns (a labelled `turn`) instead of travelling further. With probability
 /// [`Knobs::handling`] the child also handles the toy once, at a random place in the sequence,
 /// without playing an action ([`Handling`], recorded in [`Doodle::handled`]); the actions are
-/// drawn the same either way.
+/// drawn from their own streams, the same either way (unless a carry took the toy past the
+/// room's edge, where a travelling action becomes a turn).
 pub fn sequence(seed: u64, knobs: &Knobs, count: usize, effort: Option<Effort>) -> Doodle {
     let mut pick = SynthRng::child(seed, Stream::Plan, 0x5e9);
     let mut aside = SynthRng::child(seed, Stream::Plan, HANDLING_STREAM);
