@@ -128,20 +128,27 @@ impl<'k> Performer<'k> {
         self.traj.last_state()
     }
 
-    /// Performs `action` with `effort`, labels it, and pauses.
-    pub fn perform(&mut self, action: Action, effort: Effort) {
-        let shape = effort.shape(&mut self.rng);
-        let strokes = plan(action, &shape, self.var.scale, &mut self.rng);
+    /// Plays `strokes` at the player's tempo; returns their first and last instant on the
+    /// log's clock (whole microseconds).
+    fn play(&mut self, strokes: Vec<Stroke>) -> (f64, f64) {
         let start = self.traj.end();
         let speed = self.var.speed;
         self.traj.extend(strokes.into_iter().map(|mut s| {
             s.duration /= speed;
             s
         }));
+        (to_micros(start), to_micros(self.traj.end()))
+    }
+
+    /// Performs `action` with `effort`, labels it, and pauses.
+    pub fn perform(&mut self, action: Action, effort: Effort) {
+        let shape = effort.shape(&mut self.rng);
+        let strokes = plan(action, &shape, self.var.scale, &mut self.rng);
+        let (start, end) = self.play(strokes);
         self.labels.push(Label {
             action: action.name().to_string(),
-            start: to_micros(start),
-            end: to_micros(self.traj.end()),
+            start,
+            end,
             time_class: effort.time,
             weight_class: effort.weight,
         });
@@ -154,16 +161,11 @@ impl<'k> Performer<'k> {
     /// would be without it.
     pub fn handle(&mut self, kind: Handling, rng: &mut SynthRng) {
         let strokes = handling::plan(kind, self.var.scale, rng);
-        let start = self.traj.end();
-        let speed = self.var.speed;
-        self.traj.extend(strokes.into_iter().map(|mut s| {
-            s.duration /= speed;
-            s
-        }));
+        let (start, end) = self.play(strokes);
         self.handled.push(Label {
             action: kind.name().to_string(),
-            start: to_micros(start),
-            end: to_micros(self.traj.end()),
+            start,
+            end,
             time_class: TimeClass::Neutral,
             weight_class: WeightClass::Neutral,
         });
