@@ -428,7 +428,8 @@ pub fn evaluate(
                 let t = super::learn::tokenize_gesture(&d.log);
                 let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
                 eprintln!(
-                    "{kind} -> {}: {}\n    played at scale {:.2} (seed {seed})",
+                    "{kind} -> {}: {}\n    played at scale {:.2} (figurine synth handling \
+                     --kind {kind} --seed {seed})",
                     got.join(" "),
                     super::library::tokens_to_string(&super::learn::tokens_only(&t)),
                     d.variation.scale
