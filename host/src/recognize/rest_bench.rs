@@ -54,7 +54,8 @@ pub struct RestBenchArgs {
     /// Also draw false alarms per hour by tracker level and kind as a PNG bar chart here.
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// List every false alarm of the shipped library, with the commands that replay it.
+    /// List every false alarm of the shipped library, and every log a learnt library fired on,
+    /// with the commands that replay them.
     #[arg(long)]
     pub verbose: bool,
 }
@@ -423,6 +424,18 @@ pub fn run(args: &RestBenchArgs) -> Result<()> {
                 a.span.1,
                 c.seed,
                 args.minutes * 60.0,
+            );
+        }
+        for (&n, seed) in c.learnt.iter().zip(&seeds).filter(|(&n, _)| n > 0) {
+            println!(
+                "  library of train seed {seed}: {n} on {kind} rest, {tracker} (figurine synth \
+                 rest --seed {} --seconds {} --kind {kind} --tracker {tracker} --out r.csv && \
+                 figurine eval --train-seed {seed} --examples {} --scale {} --save-library \
+                 l.json && figurine simulate --library l.json r.csv)",
+                c.seed,
+                args.minutes * 60.0,
+                args.examples,
+                args.learn_knobs().scale,
             );
         }
     }
