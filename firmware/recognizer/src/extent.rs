@@ -8,7 +8,9 @@
 //! when its motion phrase went at least [`ACCEPT_SHARE`] of that, in a dimension that carries
 //! the action ([`far_enough`]), and farther than a fidget goes ([`FIDGET_MOVED_M`],
 //! [`FIDGET_TURNED_RAD`]): a tabletop player's examples of a few centimetres would otherwise
-//! admit a share smaller than the fidget itself.
+//! admit a share smaller than the fidget itself. Seen through a noisy tracker a fidget seems
+//! to go farther — its farthest point is read from noisy poses — so the fidget's reach grows
+//! with the noise the front end learnt at rest ([`noise_reach`]).
 //!
 //! | measure | what | units |
 //! |---|---|---|
@@ -50,6 +52,12 @@ pub const FIDGET_MOVED_M: f32 = 0.010;
 /// Rotation that is never far enough for an action, rad (about 6°): just beyond the largest
 /// tilt a hand's fidget makes (1–5°).
 pub const FIDGET_TURNED_RAD: f32 = 0.10;
+/// How far the tracker's noise alone seems to take the figurine, per unit of its learnt
+/// velocity noise rms (s): the farthest point of a phrase is read from the Savitzky–Golay
+/// smoothed pose at its runs' ends, and white position noise that makes a velocity rms σᵥ
+/// puts two such readings √2·σ apart with σ ≈ 0.026 s × σᵥ at 100–1000 Hz (0.036 s at
+/// 30 Hz); the farthest of a few readings lies about 1.5–2 times that.
+pub const NOISE_REACH_S: f32 = 0.05;
 /// Share of the other dimension's least extent (rotation × [`ARM_M`]) a dimension must reach
 /// to carry an action: a punch barely turns and a turn barely moves; a kick and a throw carry
 /// both.
@@ -125,21 +133,32 @@ pub fn span_extent(hist: &History, from: u32, to: u32) -> Extent {
     sums.extent()
 }
 
+/// How far the noise alone seems to take the figurine ([`NOISE_REACH_S`]), from the learnt
+/// noise rms of translation (m/s) and rotation (rad/s).
+pub fn noise_reach(rms: (f32, f32)) -> Extent {
+    Extent {
+        moved_m: NOISE_REACH_S * rms.0,
+        turned_rad: NOISE_REACH_S * rms.1,
+        travel_m: 0.0,
+    }
+}
+
 /// Whether motion that went `went` went far enough to be an action whose least example went
 /// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
 /// in a dimension that carries the action, and as far across the floor when moving carries
 /// it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved, and
-/// farther than a fidget).
-pub fn far_enough(went: Extent, least: Extent) -> bool {
+/// farther than a fidget). A fidget seen through a tracker's `noise` ([`noise_reach`])
+/// reaches as far as the two together (in quadrature: they are independent).
+pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
     let need_moved = fmath::max(
         fmath::min(ACCEPT_SHARE * least.moved_m, ENOUGH_MOVED_M),
-        FIDGET_MOVED_M,
+        fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]),
     );
     let need_turned = fmath::max(
         fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD),
-        FIDGET_TURNED_RAD,
+        fmath::norm3([FIDGET_TURNED_RAD, noise.turned_rad, 0.0]),
     );
     // Travel is part of moving: it carries an action that moving carries, when its examples
     // ended at least that share as far off as they went (a turn's grip swings the tracked
@@ -177,6 +196,13 @@ mod tests {
     use crate::features::QUANTITIES;
     use crate::intake::TICK_S;
     use crate::token::parse_token;
+
+    /// A noiseless tracker's reach.
+    const QUIET: Extent = Extent {
+        moved_m: 0.0,
+        turned_rad: 0.0,
+        travel_m: 0.0,
+    };
 
     fn ext(moved_m: f32, turned_rad: f32) -> Extent {
         Extent {
@@ -254,19 +280,45 @@ mod tests {
         // A fidget moves more than a turn's examples drifted and turns more than a punch's:
         // neither dimension carries those actions, so it is neither.
         for least in [punch, turn, throw] {
-            assert!(!far_enough(fidget, least), "{least:?}");
+            assert!(!far_enough(fidget, least, QUIET), "{least:?}");
         }
         // A small punch, a quick quarter turn, a throw that swung without reaching: all far
         // enough.
         let small_punch = ext(0.04, 0.0);
-        assert!(far_enough(small_punch, punch));
+        assert!(far_enough(small_punch, punch, QUIET));
         let quarter = ext(0.0, 0.4);
-        assert!(far_enough(quarter, turn));
+        assert!(far_enough(quarter, turn, QUIET));
         let swing = ext(0.01, 0.2);
-        assert!(far_enough(swing, throw));
+        assert!(far_enough(swing, throw, QUIET));
         // Examples that went nowhere admit anything that goes farther than a fidget.
-        assert!(far_enough(ext(0.012, 0.0), Extent::default()));
-        assert!(!far_enough(Extent::default(), Extent::default()));
+        assert!(far_enough(ext(0.012, 0.0), Extent::default(), QUIET));
+        assert!(!far_enough(Extent::default(), Extent::default(), QUIET));
+    }
+
+    #[test]
+    fn a_fidget_seen_through_a_noisy_tracker_must_go_farther() {
+        // A tabletop punch (its least example 4 cm: 15 % of it is under a fidget's reach).
+        let punch = ext(0.04, 0.0);
+        // A small turn (its least example 0.5 rad: 15 % of it under a fidget's tilt).
+        let turn = ext(0.0, 0.5);
+        // A webcam-like tracker: 0.1 m/s and 0.3 rad/s of velocity noise at rest, which
+        // alone seems to take the figurine 5 mm and 0.015 rad.
+        let noisy = noise_reach((0.1, 0.3));
+        assert!((noisy.moved_m - 0.005).abs() < 1e-6, "{noisy:?}");
+        // A 10.5 mm shift clears the fidget's reach on a quiet tracker, not on this one
+        // (√(10² + 5²) ≈ 11.2 mm); a 2 cm one clears both.
+        assert!(far_enough(ext(0.0105, 0.0), punch, QUIET));
+        assert!(!far_enough(ext(0.0105, 0.0), punch, noisy));
+        assert!(far_enough(ext(0.02, 0.0), punch, noisy));
+        // Alike in rotation: 0.105 rad against √(0.1² + 0.015²) ≈ 0.101 passes, 0.1005 fails.
+        assert!(far_enough(ext(0.0, 0.105), turn, noisy));
+        assert!(!far_enough(ext(0.0, 0.1005), turn, noisy));
+        // The reach adds in quadrature: a quiet tracker's small noise barely moves the floor.
+        assert!(far_enough(
+            ext(0.01005, 0.0),
+            punch,
+            noise_reach((0.01, 0.03))
+        ));
     }
 
     #[test]
@@ -281,25 +333,25 @@ mod tests {
             travel_m: 0.004,
             ..ext(0.1, 0.1)
         };
-        assert!(!far_enough(lift, jump));
+        assert!(!far_enough(lift, jump, QUIET));
         // A small jump that landed a few centimetres ahead is one.
         let small = Extent {
             travel_m: 0.03,
             ..ext(0.08, 0.05)
         };
-        assert!(far_enough(small, jump));
+        assert!(far_enough(small, jump, QUIET));
         // A crouch's examples came back where they started: its travel carries nothing.
         let crouch = Extent {
             travel_m: 0.01,
             ..ext(0.1, 0.1)
         };
-        assert!(far_enough(lift, crouch));
+        assert!(far_enough(lift, crouch, QUIET));
         // Nor does a turn's, carried by its rotation, though the grip swung it 5 cm aside.
         let turn = Extent {
             travel_m: 0.05,
             ..ext(0.05, 1.6)
         };
-        assert!(far_enough(ext(0.0, 1.0), turn));
+        assert!(far_enough(ext(0.0, 1.0), turn, QUIET));
     }
 
     #[test]
@@ -320,11 +372,11 @@ mod tests {
         // hand's fidget reaches; the fidget's own reach is the bound then.
         let small = ext(0.03, 0.0);
         assert!(ACCEPT_SHARE * small.moved_m < 0.008);
-        assert!(!far_enough(ext(0.008, 0.0), small));
-        assert!(far_enough(ext(0.012, 0.0), small));
+        assert!(!far_enough(ext(0.008, 0.0), small, QUIET));
+        assert!(far_enough(ext(0.012, 0.0), small, QUIET));
         let small_turn = ext(0.0, 0.7);
-        assert!(!far_enough(ext(0.0, 0.09), small_turn));
-        assert!(far_enough(ext(0.0, 0.12), small_turn));
+        assert!(!far_enough(ext(0.0, 0.09), small_turn, QUIET));
+        assert!(far_enough(ext(0.0, 0.12), small_turn, QUIET));
     }
 
     #[test]

@@ -79,6 +79,11 @@ impl Frontend {
         self.last_tick_us
     }
 
+    /// The noise rms of translation (m/s) and rotation (rad/s) learnt at rest so far.
+    pub fn noise_rms(&self) -> (f32, f32) {
+        self.tokenizer.noise_rms()
+    }
+
     /// The run history.
     pub fn history(&self) -> &History {
         &self.history

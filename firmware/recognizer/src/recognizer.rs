@@ -10,7 +10,7 @@
 use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, MatcherBank, Matches};
 use crate::bayes::{quantise, EffortModel};
-use crate::extent::{far_enough, span_extent};
+use crate::extent::{far_enough, noise_reach, span_extent};
 use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::frontend::{FrontEvent, Frontend};
@@ -545,9 +545,12 @@ impl<'lib> Recognizer<'lib> {
     /// did not go as far as its action's examples ([`far_enough`]: a fidget).
     fn outcome(&self, c: &Candidate, held: Option<Held>) -> Option<(Held, bool, Option<Held>)> {
         let (ev, (from, to)) = self.event_of(c)?;
-        // Only a new event is held to its action's extent; a continuation's went before.
+        // Only a new event is held to its action's extent; a continuation's went before. A
+        // fidget seems to go as far as the tracker's noise takes it besides.
+        let hist = self.front.history();
+        let noise = noise_reach(self.front.noise_rms());
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
-            Some(least) if !far_enough(span_extent(self.front.history(), from, to), least) => None,
+            Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => None,
             _ => Some((ev, false, Some(ev))),
         };
         let Some(mut h) = held else {
@@ -555,7 +558,6 @@ impl<'lib> Recognizer<'lib> {
         };
         // Past the usual pause, only the rest of a hold its action's examples made (a crouch
         // held low, then risen from) continues it.
-        let hist = self.front.history();
         let gap = c.start.wrapping_sub(h.end_run);
         let late = gap <= HISTORY_RUNS as u32
             && (1..gap)

@@ -413,6 +413,11 @@ impl Tokenizer {
         self.floor.quiet(k.world_v, k.w)
     }
 
+    /// The learnt noise rms of translation (m/s) and rotation (rad/s).
+    pub fn noise_rms(&self) -> (f32, f32) {
+        self.floor.rms()
+    }
+
     /// The token of the current run, if any.
     pub fn current(&self) -> Option<Token> {
         self.current
