@@ -92,6 +92,19 @@ pub struct EvalArgs {
 }
 
 impl EvalArgs {
+    /// This evaluation's tracker and scale as `figurine synth` flags (" --noise 3"…), to
+    /// regenerate one of its logs.
+    pub fn knob_flags(&self) -> String {
+        [
+            ("noise", self.noise),
+            ("rate", self.rate),
+            ("scale", self.scale),
+        ]
+        .iter()
+        .filter_map(|(name, r)| r.map(|r| format!(" --{name} {r}")))
+        .collect()
+    }
+
     /// The generator's knobs, with this evaluation's tracker and scale.
     pub fn knobs(&self) -> Knobs {
         let mut k = Knobs::default();
@@ -429,10 +442,11 @@ pub fn evaluate(
                 let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
                 eprintln!(
                     "{kind} -> {}: {}\n    played at scale {:.2} (figurine synth handling \
-                     --kind {kind} --seed {seed})",
+                     --kind {kind} --seed {seed}{})",
                     got.join(" "),
                     super::library::tokens_to_string(&super::learn::tokens_only(&t)),
-                    d.variation.scale
+                    d.variation.scale,
+                    args.knob_flags()
                 );
             }
         }
@@ -456,6 +470,16 @@ pub fn evaluate(
             }
         }
         let pairs = pair_events(&d.labels, &evs);
+        if args.verbose
+            && (pairs.iter().any(Option::is_none) || pairs.iter().flatten().count() < evs.len())
+        {
+            eprintln!(
+                "  sequence {k}: figurine synth sequence --seed {seed} --count {}{} --out s.csv \
+                 --labels s.json",
+                args.sequence_len,
+                args.knob_flags()
+            );
+        }
         let mut used = vec![false; evs.len()];
         for (l, &i) in d.labels.iter().zip(&pairs) {
             if let Some(i) = i {
