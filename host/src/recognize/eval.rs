@@ -707,4 +707,30 @@ pub(crate) mod tests {
             }
         );
     }
+
+    #[test]
+    fn the_regenerate_flags_name_the_tracker_and_scale_asked() {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            eval: EvalArgs,
+        }
+        let flags = |argv: &[&str]| {
+            let cli = <Cli as clap::Parser>::try_parse_from(argv).unwrap();
+            cli.eval.knob_flags()
+        };
+        assert_eq!(flags(&["eval"]), "");
+        assert_eq!(
+            flags(&["eval", "--noise", "3", "--scale", "0.1..0.3"]),
+            " --noise 3 --scale 0.1..0.3"
+        );
+        // The flags parse back to the same knobs.
+        let back = <Cli as clap::Parser>::try_parse_from(
+            ["eval"]
+                .into_iter()
+                .chain(" --noise 3 --scale 0.1..0.3".split_whitespace()),
+        )
+        .unwrap();
+        assert_eq!(back.eval.knobs().scale, Range::new(0.1, 0.3));
+    }
 }
