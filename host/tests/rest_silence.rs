@@ -10,8 +10,8 @@ use figurine_host::recognize::library::LibraryFile;
 use figurine_host::recognize::simulate::simulate_log;
 use figurine_host::synth::knobs::{Knobs, Range};
 use figurine_host::synth::{
-    gesture, rest_log, Action, Effort, RestKind, RestSpec, TimeClass, TrackerLevel, WeightClass,
-    TRACKER_LEVELS,
+    gesture, rest_log, Action, Effort, RestKind, RestLog, RestSpec, TimeClass, TrackerLevel,
+    WeightClass, TRACKER_LEVELS,
 };
 use figurine_recognizer::{EffortModel, Library, Recognizer};
 
@@ -118,6 +118,29 @@ fn fidgets_that_spell_an_action_are_no_action() {
     }
 }
 
+/// A tabletop player's doodles: scale 0.3, gestures of about 4 cm.
+fn tabletop() -> Knobs {
+    Knobs {
+        scale: Range::new(0.3, 0.3),
+        ..Knobs::default()
+    }
+}
+
+/// `seconds` of a hand holding the figurine still under a webcam tag tracker at 1 m, at
+/// `rate_hz` (None: the tracker level's own).
+fn webcam_far_hand(seed: u64, seconds: f64, rate_hz: Option<Range>) -> RestLog {
+    rest_log(
+        seed,
+        &RestSpec {
+            seconds,
+            kind: Some(RestKind::Hand),
+            tracker: TrackerLevel::by_name("webcam-far"),
+            rate_hz,
+            ..RestSpec::default()
+        },
+    )
+}
+
 /// A tabletop player's library — examples of a few centimetres, learnt at doodle scale 0.3 —
 /// admits a share of its least example smaller than a hand's fidget; the fidget's own reach
 /// bounds it. A webcam-far hand rest at 30 Hz on which such a library read a fidget as a
@@ -126,23 +149,11 @@ fn fidgets_that_spell_an_action_are_no_action() {
 /// own scale.
 #[test]
 fn a_tabletop_players_library_stays_silent_through_a_hands_fidgets() {
-    let knobs = Knobs {
-        scale: Range::new(0.3, 0.3),
-        ..Knobs::default()
-    };
+    let knobs = tabletop();
     let mut lib = learn_synth_library(21, 3, &knobs).unwrap();
     let (names, blob) = (lib.names(), lib.blob().unwrap());
     let (_, effort) = shipped();
-    let rest = rest_log(
-        16,
-        &RestSpec {
-            seconds: 600.0,
-            kind: Some(RestKind::Hand),
-            tracker: TrackerLevel::by_name("webcam-far"),
-            rate_hz: Some(Range::new(30.0, 30.0)),
-            ..RestSpec::default()
-        },
-    );
+    let rest = webcam_far_hand(16, 600.0, Some(Range::new(30.0, 30.0)));
     assert!(!rest.info.fidgets.is_empty());
     let sim = simulate_log(&rest.log, &names, &blob, Some(effort)).unwrap();
     let read: Vec<String> = sim.records.iter().map(|r| r.action.clone()).collect();
@@ -167,20 +178,9 @@ fn a_tabletop_players_library_stays_silent_through_a_hands_fidgets() {
 /// silent; and each library still reads its own small punches through the same tracker.
 #[test]
 fn a_fidget_through_a_noisy_tracker_must_go_as_far_as_the_noise_takes_it_besides() {
-    let knobs = Knobs {
-        scale: Range::new(0.3, 0.3),
-        ..Knobs::default()
-    };
+    let knobs = tabletop();
     let (_, effort) = shipped();
-    let rest = rest_log(
-        9_622_762_712_683_258_009,
-        &RestSpec {
-            seconds: 300.0,
-            kind: Some(RestKind::Hand),
-            tracker: TrackerLevel::by_name("webcam-far"),
-            ..RestSpec::default()
-        },
-    );
+    let rest = webcam_far_hand(9_622_762_712_683_258_009, 300.0, None);
     assert!(!rest.info.fidgets.is_empty());
     let webcam = Knobs {
         noise: Range::new(2.0, 2.0),
