@@ -173,7 +173,7 @@ fn a_tabletop_players_library_stays_silent_through_a_hands_fidgets() {
 /// Seen through a noisy tracker a fidget seems to go farther than it does: its farthest point
 /// is read from noisy poses. A hand's five minutes of rest under a webcam-far tracker at
 /// 30 Hz (depth jitter 2.8 mm), on which three tabletop players' libraries each read one
-/// fidget as a throw while the fidget's reach did not grow with the noise (found with
+/// fidget as an action while the fidget's reach did not grow with the noise (found with
 /// `figurine eval rest --hours 20 --seed 5 --scale 0.3 --train-seed 50 --verbose`), stays
 /// silent; and each library still reads its own small punches through the same tracker.
 #[test]

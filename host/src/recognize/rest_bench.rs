@@ -55,7 +55,8 @@ pub struct RestBenchArgs {
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// List every false alarm of the shipped library, and every log a learnt library fired on,
-    /// with the commands that replay them.
+    /// with the commands that replay them (through the written CSV, whose rounding can tip an
+    /// alarm at the edge either way).
     #[arg(long)]
     pub verbose: bool,
 }
