@@ -470,10 +470,10 @@ pub fn handled_spans(text: &str) -> Vec<Label> {
 /// Reads a pose log (and labels JSON), plots it with the handling it records, and writes the
 /// PNG.
 pub fn plot_files(log: &Path, labels: Option<&Path>, out: &Path) -> Result<()> {
-    let pl = PoseLog::read_path(log)?;
-    let handled = std::fs::read_to_string(log)
-        .map(|t| handled_spans(&t))
-        .unwrap_or_default();
+    // Read once: the samples and the `# handled` lines come from the same bytes.
+    let bytes = std::fs::read(log).with_context(|| format!("reading {}", log.display()))?;
+    let pl = PoseLog::read(bytes.as_slice(), log)?;
+    let handled = handled_spans(&String::from_utf8_lossy(&bytes));
     let labels: Vec<Label> = match labels {
         Some(p) => {
             let text =
