@@ -44,6 +44,10 @@ pub struct BenchArgs {
     /// Edge of the tag's black square, metres.
     #[arg(long, default_value_t = 0.04)]
     pub tag_size: f64,
+    /// Frames per second of the rendered camera (many webcams also give 60 at 640×480: half
+    /// the turn and the smear from one frame to the next).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
     /// Search every frame whole, not near the tag's last place first (slower; for
     /// comparing the two).
     #[arg(long)]
@@ -362,6 +366,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.tag_size
         );
     }
+    if !(args.fps >= 1.0 && args.fps <= 1000.0) {
+        anyhow::bail!("--fps {}: frames per second, 1 to 1000", args.fps);
+    }
     let tmp;
     let dir = match &args.keep {
         Some(d) => {
@@ -398,6 +405,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         tag_size: args.tag_size,
         seed: args.seed.wrapping_add(di as u64),
         rig_box,
+        fps: args.fps,
         ..Setup::default()
     };
     let mut runs = Vec::new();

@@ -125,8 +125,8 @@ fn truths_head(setup: &Setup) -> String {
         format!(", box {} × {} m{top}", b.width, b.depth)
     });
     format!(
-        "# tag {} m at {} m, seed {}{rig}",
-        setup.tag_size, setup.distance, setup.seed
+        "# tag {} m at {} m, seed {}, {} fps{rig}",
+        setup.tag_size, setup.distance, setup.seed, setup.fps
     )
 }
 
@@ -171,6 +171,9 @@ mod tests {
             ..setup
         };
         assert!(read_truths(&path, &other, &sc).is_err());
+        // A video kept at another frame rate is not the one asked for.
+        let faster = Setup { fps: 60.0, ..setup };
+        assert!(read_truths(&path, &faster, &sc).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
