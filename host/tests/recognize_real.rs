@@ -7,8 +7,8 @@
 
 use figurine_host::data::data_file;
 use figurine_host::poselog::{PoseLog, PoseSample};
+use figurine_host::recognize::columns::edit_distance;
 use figurine_host::recognize::feed::{log_runs, log_samples};
-use figurine_host::recognize::learn::edit_distance;
 use figurine_host::recognize::simulate::{load_effort, load_library, simulate_log};
 use figurine_recognizer::token::{Token, STILL};
 

@@ -392,7 +392,7 @@ pub fn evaluate(
                     eprintln!(
                         "{} -> {got}: {}",
                         l.action,
-                        super::library::tokens_to_string(&super::learn::tokens_only(&t))
+                        super::library::tokens_to_string(&super::intent::tokens_only(&t))
                     );
                     eprintln!(
                         "    played at {:.0} Hz, scale {:.2}, speed {:.2}, noise {:.2}, {:?}/{:?} \
@@ -444,7 +444,7 @@ pub fn evaluate(
                     "{kind} -> {}: {}\n    played at scale {:.2} (figurine synth handling \
                      --kind {kind} --seed {seed}{})",
                     got.join(" "),
-                    super::library::tokens_to_string(&super::learn::tokens_only(&t)),
+                    super::library::tokens_to_string(&super::intent::tokens_only(&t)),
                     d.variation.scale,
                     args.knob_flags()
                 );

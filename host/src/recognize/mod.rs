@@ -4,7 +4,7 @@
 //! - [`feed`]: logs → wire-quantised samples → recognizer / front end.
 //! - [`regex`]: pattern sources → Glushkov automata → device records.
 //! - [`library`] / [`effort_model`]: LIB.json and EFFORT.json, and their device blobs.
-//! - [`dtw`] + [`learn`] + [`separate`]: `figurine learn`.
+//! - [`dtw`] + [`learn`] ([`intent`], [`columns`], [`sides`]) + [`separate`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ `font`): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
 //! - [`eval_cli`]: `figurine eval`, the accuracy tables of [`eval`] (+ [`eval_pairs`]) or a
@@ -15,6 +15,7 @@
 //! - [`doodle`]: `figurine doodle`, a motion-capture take as a figurine pose log;
 //!   [`real_bench`]: `figurine eval real` (recognition on labelled real doodles).
 
+pub mod columns;
 pub mod doodle;
 pub mod dtw;
 pub mod effort_model;
@@ -23,6 +24,7 @@ pub mod eval;
 pub mod eval_cli;
 pub mod eval_pairs;
 pub mod feed;
+pub mod intent;
 pub mod learn;
 pub mod library;
 pub mod real_bench;
@@ -31,6 +33,7 @@ pub mod repeat_bench;
 pub mod report;
 pub mod rest_bench;
 pub mod separate;
+pub mod sides;
 pub mod simulate;
 pub mod sweep;
 pub mod tokens;
