@@ -45,7 +45,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 0.04)]
     pub tag_size: f64,
     /// Frames per second of the rendered camera (many webcams also give 60 at 640×480: half
-    /// the turn and the smear from one frame to the next).
+    /// the turn from one frame to the next; the smear is the 8 ms exposure's either way).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
     /// Search every frame whole, not near the tag's last place first (slower; for
