@@ -16,7 +16,11 @@ use serde::Deserialize;
 
 use super::doodle::{doodle, Doodle, DoodleSpec};
 use super::eval::learn_synth_library;
+use super::learn::learn_action;
+use super::library::LibraryFile;
+use super::separate::separate;
 use super::simulate::{load_effort, load_library, simulate_log};
+use crate::poselog::PoseLog;
 use crate::synth::Knobs;
 
 /// The labelled takes, compiled in.
@@ -91,6 +95,54 @@ pub struct RealBenchArgs {
     /// Examples per action of each `--libraries` library (the shipped library's: 3).
     #[arg(long, default_value_t = 3, requires = "libraries")]
     pub examples: usize,
+    /// Teach the library with real performances, as a user with motion capture would: each
+    /// take is read by a library in which every action that other takes play alone (one
+    /// label, cut to its span) is learnt from up to [`TAUGHT_EXAMPLES`] of them — never from
+    /// the take being read — and the other actions as the shipped library's are.
+    #[arg(long, conflicts_with_all = ["library", "libraries"])]
+    pub taught: bool,
+}
+
+/// Take `t` cut to label `l`'s span (all of `t` when the label has none).
+fn labelled_span(t: &RealTake, l: &RealLabel) -> RealTake {
+    let (start, end) = l.span.map_or((t.start, t.end), |(a, b)| (Some(a), Some(b)));
+    RealTake {
+        start,
+        end,
+        ..t.clone()
+    }
+}
+
+/// Real performances a `--taught` library learns an action from, at most.
+pub const TAUGHT_EXAMPLES: usize = 3;
+
+/// The library take `leave_out` of `takes` is read with under `--taught`: `base` (learnt from
+/// the generator), with every action that other takes play alone (one label) relearnt from up
+/// to [`TAUGHT_EXAMPLES`] of their doodles cut to the label's span (in the takes' order), then
+/// separated again; and the actions so taught.
+pub fn taught_library(
+    takes: &[RealTake],
+    leave_out: usize,
+    base: &LibraryFile,
+) -> Result<(LibraryFile, Vec<String>)> {
+    let mut by_action: std::collections::BTreeMap<&str, Vec<PoseLog>> = Default::default();
+    for (i, t) in takes.iter().enumerate() {
+        let [only] = t.actions.as_slice() else {
+            continue;
+        };
+        let examples = by_action.entry(only.action.as_str()).or_default();
+        if i != leave_out && examples.len() < TAUGHT_EXAMPLES {
+            examples.push(take_doodle(&labelled_span(t, only))?.0.log);
+        }
+    }
+    let mut lib = base.clone();
+    let mut taught = Vec::new();
+    for (action, logs) in by_action.into_iter().filter(|(_, l)| !l.is_empty()) {
+        lib.upsert(learn_action(action, &logs, None, true)?);
+        taught.push(action.to_string());
+    }
+    separate(&mut lib)?;
+    Ok((lib, taught))
 }
 
 /// One take's outcome.
@@ -228,6 +280,32 @@ pub fn run(args: &RealBenchArgs) -> Result<()> {
     let takes = real_takes()?;
     let effort = load_effort(None)?;
     let runs = match args.libraries {
+        None if args.taught => {
+            let base = learn_synth_library(1, 3, &Knobs::default())?;
+            let mut scores = Vec::new();
+            for i in 0..takes.len() {
+                let (mut lib, taught) = taught_library(&takes, i, &base)?;
+                eprintln!(
+                    "{}: {} taught by other takes",
+                    takes[i].take,
+                    if taught.is_empty() {
+                        "no action".to_string()
+                    } else {
+                        taught.join(", ")
+                    }
+                );
+                let save = args.save.as_deref();
+                let one = std::slice::from_ref(&takes[i]);
+                scores.extend(score_takes(
+                    one,
+                    &lib.names(),
+                    &lib.blob()?,
+                    Some(effort),
+                    save,
+                )?);
+            }
+            vec![scores]
+        }
         None => {
             let (lib, blob) = load_library(args.library.as_deref())?;
             vec![score_takes(
@@ -376,6 +454,50 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_taught_library_never_learns_from_the_take_it_reads() {
+        let takes = real_takes().unwrap();
+        if let Err(e) = takes.iter().try_for_each(|t| take_doodle(t).map(|_| ())) {
+            eprintln!("skipping: {e}");
+            return;
+        }
+        let alone = |action: &str| -> Vec<usize> {
+            (0..takes.len())
+                .filter(|&i| matches!(takes[i].actions.as_slice(), [l] if l.action == action))
+                .collect()
+        };
+        let tokens = |i: usize| {
+            let [only] = takes[i].actions.as_slice() else {
+                unreachable!()
+            };
+            let log = take_doodle(&labelled_span(&takes[i], only)).unwrap().0.log;
+            let t = super::super::learn::tokenize_gesture(&log);
+            super::super::library::tokens_to_string(&super::super::intent::tokens_only(&t))
+        };
+        let base = learn_synth_library(1, 1, &Knobs::default()).unwrap();
+        // The one take that runs alone teaches a run to every other take's library, not its own.
+        let [run] = alone("run")[..] else {
+            panic!("one take runs alone")
+        };
+        let (_, taught) = taught_library(&takes, run, &base).unwrap();
+        assert!(!taught.contains(&"run".to_string()), "{taught:?}");
+        let (_, taught) = taught_library(&takes, (run + 1) % takes.len(), &base).unwrap();
+        assert!(taught.contains(&"run".to_string()), "{taught:?}");
+        // A walk is read with a walk learnt from the first three other walks, in order.
+        let walks = alone("walk");
+        assert!(walks.len() > TAUGHT_EXAMPLES, "{walks:?}");
+        let read = walks[1];
+        let (lib, _) = taught_library(&takes, read, &base).unwrap();
+        let walk = lib.actions.iter().find(|a| a.name == "walk").unwrap();
+        let want: Vec<String> = walks
+            .iter()
+            .filter(|&&i| i != read)
+            .take(TAUGHT_EXAMPLES)
+            .map(|&i| tokens(i))
+            .collect();
+        assert_eq!(walk.examples, want);
     }
 
     #[test]
