@@ -116,28 +116,39 @@ fn labelled_span(t: &RealTake, l: &RealLabel) -> RealTake {
 /// Real performances a `--taught` library learns an action from, at most.
 pub const TAUGHT_EXAMPLES: usize = 3;
 
-/// The library take `leave_out` of `takes` is read with under `--taught`: `base` (learnt from
-/// the generator), with every action that other takes play alone (one label) relearnt from up
-/// to [`TAUGHT_EXAMPLES`] of their doodles cut to the label's span (in the takes' order), then
-/// separated again; and the actions so taught.
+/// The real performances a `--taught` library may learn from: every take that plays one action
+/// alone (one label), as (take index, action, its doodle cut to the label's span), in the
+/// takes' order. Made once, whichever take is then left out.
+pub fn taught_examples(takes: &[RealTake]) -> Result<Vec<(usize, String, PoseLog)>> {
+    let mut out = Vec::new();
+    for (i, t) in takes.iter().enumerate() {
+        if let [only] = t.actions.as_slice() {
+            let log = take_doodle(&labelled_span(t, only))?.0.log;
+            out.push((i, only.action.clone(), log));
+        }
+    }
+    Ok(out)
+}
+
+/// The library take `leave_out` is read with under `--taught`: `base` (learnt from the
+/// generator), with every action that other takes play alone relearnt from up to
+/// [`TAUGHT_EXAMPLES`] of their [`taught_examples`] (in the takes' order), then separated
+/// again; and the actions so taught.
 pub fn taught_library(
-    takes: &[RealTake],
+    examples: &[(usize, String, PoseLog)],
     leave_out: usize,
     base: &LibraryFile,
 ) -> Result<(LibraryFile, Vec<String>)> {
     let mut by_action: std::collections::BTreeMap<&str, Vec<PoseLog>> = Default::default();
-    for (i, t) in takes.iter().enumerate() {
-        let [only] = t.actions.as_slice() else {
-            continue;
-        };
-        let examples = by_action.entry(only.action.as_str()).or_default();
-        if i != leave_out && examples.len() < TAUGHT_EXAMPLES {
-            examples.push(take_doodle(&labelled_span(t, only))?.0.log);
+    for (_, action, log) in examples.iter().filter(|(i, ..)| *i != leave_out) {
+        let logs = by_action.entry(action.as_str()).or_default();
+        if logs.len() < TAUGHT_EXAMPLES {
+            logs.push(log.clone());
         }
     }
     let mut lib = base.clone();
     let mut taught = Vec::new();
-    for (action, logs) in by_action.into_iter().filter(|(_, l)| !l.is_empty()) {
+    for (action, logs) in by_action {
         lib.upsert(learn_action(action, &logs, None, true)?);
         taught.push(action.to_string());
     }
@@ -282,12 +293,13 @@ pub fn run(args: &RealBenchArgs) -> Result<()> {
     let runs = match args.libraries {
         None if args.taught => {
             let base = learn_synth_library(1, 3, &Knobs::default())?;
+            let examples = taught_examples(&takes)?;
             let mut scores = Vec::new();
-            for i in 0..takes.len() {
-                let (mut lib, taught) = taught_library(&takes, i, &base)?;
+            for (i, take) in takes.iter().enumerate() {
+                let (mut lib, taught) = taught_library(&examples, i, &base)?;
                 eprintln!(
                     "{}: {} taught by other takes",
-                    takes[i].take,
+                    take.take,
                     if taught.is_empty() {
                         "no action".to_string()
                     } else {
@@ -295,7 +307,7 @@ pub fn run(args: &RealBenchArgs) -> Result<()> {
                     }
                 );
                 let save = args.save.as_deref();
-                let one = std::slice::from_ref(&takes[i]);
+                let one = std::slice::from_ref(take);
                 scores.extend(score_takes(
                     one,
                     &lib.names(),
@@ -477,19 +489,20 @@ mod tests {
             super::super::library::tokens_to_string(&super::super::intent::tokens_only(&t))
         };
         let base = learn_synth_library(1, 1, &Knobs::default()).unwrap();
+        let examples = taught_examples(&takes).unwrap();
         // The one take that runs alone teaches a run to every other take's library, not its own.
         let [run] = alone("run")[..] else {
             panic!("one take runs alone")
         };
-        let (_, taught) = taught_library(&takes, run, &base).unwrap();
+        let (_, taught) = taught_library(&examples, run, &base).unwrap();
         assert!(!taught.contains(&"run".to_string()), "{taught:?}");
-        let (_, taught) = taught_library(&takes, (run + 1) % takes.len(), &base).unwrap();
+        let (_, taught) = taught_library(&examples, (run + 1) % takes.len(), &base).unwrap();
         assert!(taught.contains(&"run".to_string()), "{taught:?}");
         // A walk is read with a walk learnt from the first three other walks, in order.
         let walks = alone("walk");
         assert!(walks.len() > TAUGHT_EXAMPLES, "{walks:?}");
         let read = walks[1];
-        let (lib, _) = taught_library(&takes, read, &base).unwrap();
+        let (lib, _) = taught_library(&examples, read, &base).unwrap();
         let walk = lib.actions.iter().find(|a| a.name == "walk").unwrap();
         let want: Vec<String> = walks
             .iter()
