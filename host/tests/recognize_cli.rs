@@ -273,3 +273,66 @@ fn eval_over_seed_pairs_prints_each_pair_and_the_mean() {
         "{err}"
     );
 }
+
+/// A pose log at 100 Hz: still 0.6 s, one stroke of 5 cm to the figurine's left lasting
+/// `stroke_s` (minimum-jerk-like), then still.
+fn left_stroke(path: &Path, stroke_s: f64) {
+    let mut csv = String::from("t,x,y,z,qw,qx,qy,qz\n");
+    for i in 0..((1.4 + stroke_s) * 100.0) as usize {
+        let t = i as f64 / 100.0;
+        let u = ((t - 0.6) / stroke_s).clamp(0.0, 1.0);
+        let x = 0.05 * (u - (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU);
+        csv += &format!("{t:.4},{x:.5},1.0,0.0,1,0,0,0\n");
+    }
+    std::fs::write(path, csv).unwrap();
+}
+
+#[test]
+fn simulate_why_names_the_rule_that_dropped_a_match() {
+    let d = tmp("why");
+    let lib = d.join("left.json");
+    std::fs::write(
+        &lib,
+        r#"{"format":"figurine-library","version":1,
+            "actions":[{"name":"left","regex":"l","max_edits":0,"examples":[]}]}"#,
+    )
+    .unwrap();
+    let why = |log: &Path| {
+        let out = figurine(&[
+            "simulate",
+            "--why",
+            "--library",
+            lib.to_str().unwrap(),
+            log.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    // A flick of a tenth of a second spells `l`, and is dropped as a flicker.
+    let flick = d.join("flick.csv");
+    left_stroke(&flick, 0.12);
+    let text = why(&flick);
+    assert!(text.contains("0 actions"), "{text}");
+    let dropped: Vec<&str> = text.lines().filter(|l| l.contains("dropped:")).collect();
+    assert_eq!(dropped.len(), 1, "{text}");
+    assert!(
+        dropped[0].starts_with("left") && dropped[0].contains("briefer than 0.15 s"),
+        "{text}"
+    );
+    // A stroke of 0.4 s is the action, and nothing was dropped.
+    let stroke = d.join("stroke.csv");
+    left_stroke(&stroke, 0.4);
+    let text = why(&stroke);
+    assert!(text.contains("1 actions"), "{text}");
+    assert!(
+        text.contains("every match committed was reported"),
+        "{text}"
+    );
+    // The notes are for the table; the JSON lines stay events only.
+    let out = figurine(&["simulate", "--why", "--jsonl", flick.to_str().unwrap()]);
+    assert!(!out.status.success());
+}

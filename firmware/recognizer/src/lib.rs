@@ -16,7 +16,8 @@
 //! new event only when it went as far as its action's examples, not a fidget: [`extent`]) →
 //! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
-//! [`history`] join the first stages; [`recognizer`] is the whole pipeline.
+//! [`history`] join the first stages; [`recognizer`] is the whole pipeline, and tells a
+//! reader who asks why a match was dropped or read as another action ([`note`]).
 //!
 //! # Capacities and RAM (with 32 actions loaded)
 //! | constant | value | RAM |
@@ -57,6 +58,7 @@ pub mod history;
 pub mod intake;
 pub mod nearest;
 pub mod noise;
+pub mod note;
 pub mod pattern;
 pub mod recognizer;
 pub mod segment;
@@ -65,6 +67,7 @@ pub mod token;
 
 pub use bayes::EffortModel;
 pub use intake::Sample;
+pub use note::{Note, Why};
 pub use pattern::Library;
 pub use recognizer::{ActionEvent, Recognizer, Stats};
 

@@ -17,6 +17,7 @@ use crate::frontend::{FrontEvent, Frontend};
 use crate::history::{History, HISTORY_RUNS};
 use crate::intake::{IntakeCounters, Sample, TICK_S};
 use crate::nearest::{nearest_action, reread, whole_phrase, Nearest, OPEN_PHRASE_US};
+use crate::note::{Note, Why};
 use crate::pattern::{Library, MAX_ACTIONS};
 use crate::segment::{
     edits_fit, Candidate, Decider, Decision, BRIEF_TURN_RAD, CONTINUE_US, GAPPED_HOLD_US,
@@ -164,7 +165,22 @@ impl<'lib> Recognizer<'lib> {
     }
 
     /// Feeds one sample; `emit` receives each action committed by it (in time order).
-    pub fn push(&mut self, s: &Sample, mut emit: impl FnMut(ActionEvent)) {
+    pub fn push(&mut self, s: &Sample, emit: impl FnMut(ActionEvent)) {
+        self.push_to(s, &mut Quiet(emit));
+    }
+
+    /// [`Self::push`], and `note` receives why each match committed by the sample was dropped
+    /// or reported as another action ([`crate::note`]); the events are the same.
+    pub fn push_noted(
+        &mut self,
+        s: &Sample,
+        emit: impl FnMut(ActionEvent),
+        note: impl FnMut(Note),
+    ) {
+        self.push_to(s, &mut Noted { event: emit, note });
+    }
+
+    fn push_to(&mut self, s: &Sample, out: &mut impl Sink) {
         self.now_us = s.t_us;
         self.now_seq = s.seq;
         let mut opened: [Option<(u32, Token)>; MAX_RUNS_PER_SAMPLE] = [None; MAX_RUNS_PER_SAMPLE];
@@ -189,7 +205,7 @@ impl<'lib> Recognizer<'lib> {
         }
         for (index, token) in opened.iter().flatten().copied() {
             if token != STILL {
-                self.feed_from(index, &mut emit);
+                self.feed_from(index, out);
             }
         }
         // Stillness: commit after a short pause, forget partial matches after a long one.
@@ -233,18 +249,18 @@ impl<'lib> Recognizer<'lib> {
                             )
                         })
                         .unwrap_or(c);
-                    self.commit(c, &mut emit);
+                    self.commit(c, out);
                     // What moved after it while it was held (a turn begun while a run's match
                     // waited for its next stride; a crouch right after a wave's last stroke) is
                     // read afresh, as after a commit at a token.
-                    self.feed_from(self.floor, &mut emit);
+                    self.feed_from(self.floor, out);
                 } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
                     // Held for a longer action that may yet take it over, or for the next
                     // cycle of a cyclic one: reported after the usual pause (weighed once per
                     // pause, not on every sample of it), and revised if it is taken over or
                     // goes on.
                     if first {
-                        self.report_provisional(p, &mut emit);
+                        self.report_provisional(p, out);
                     }
                 } else if still >= LONG_PAUSE_US && self.decider.pending().is_none() {
                     self.restart_matching();
@@ -269,7 +285,8 @@ impl<'lib> Recognizer<'lib> {
                     }) = found
                     {
                         self.nearest = Some((run, None));
-                        self.commit(c, &mut emit);
+                        out.note(|| self.note_of(&c, Why::Nearest));
+                        self.commit(c, out);
                     }
                 }
                 // As long as its action's examples held still inside, and no shorter.
@@ -341,12 +358,12 @@ impl<'lib> Recognizer<'lib> {
             || (tolerance > 0 && (alive_from(ps, false) || alive_from(ps + 1, false)))
     }
 
-    fn emit_held(&mut self, h: Held, revises: bool, emit: &mut impl FnMut(ActionEvent)) {
+    fn emit_held(&mut self, h: Held, revises: bool, out: &mut impl Sink) {
         let (lt, lw) = match &self.effort {
             Some(m) => m.classify(&segment_features(&h.acc)),
             None => (0.0, 0.0),
         };
-        emit(ActionEvent {
+        out.event(ActionEvent {
             action: h.action,
             start_seq: h.start.0,
             start_us: h.start.1,
@@ -365,9 +382,18 @@ impl<'lib> Recognizer<'lib> {
     /// Commits the pending candidate, if any (end of stream); then, if no event took the
     /// stream's last phrase, reports its nearest action as after a pause (a log that ends
     /// right after a gesture no action matched closely keeps that gesture).
-    pub fn flush(&mut self, mut emit: impl FnMut(ActionEvent)) {
+    pub fn flush(&mut self, emit: impl FnMut(ActionEvent)) {
+        self.flush_to(&mut Quiet(emit));
+    }
+
+    /// [`Self::flush`], with notes as [`Self::push_noted`] gives them.
+    pub fn flush_noted(&mut self, emit: impl FnMut(ActionEvent), note: impl FnMut(Note)) {
+        self.flush_to(&mut Noted { event: emit, note });
+    }
+
+    fn flush_to(&mut self, out: &mut impl Sink) {
         if let Some(c) = self.decider.pending() {
-            self.commit(c, &mut emit);
+            self.commit(c, out);
         }
         let hist = self.front.history();
         if let Some(newest) = hist.newest() {
@@ -382,7 +408,8 @@ impl<'lib> Recognizer<'lib> {
                 open: false,
             }) = self.nearest_to(last, true)
             {
-                self.commit(c, &mut emit);
+                out.note(|| self.note_of(&c, Why::Nearest));
+                self.commit(c, out);
             }
         }
         self.held = None;
@@ -404,7 +431,7 @@ impl<'lib> Recognizer<'lib> {
     }
 
     /// Feeds runs `from..=newest` (non-STILL ones) to the automata, committing as decided.
-    fn feed_from(&mut self, from: u32, emit: &mut impl FnMut(ActionEvent)) {
+    fn feed_from(&mut self, from: u32, out: &mut impl Sink) {
         let mut i = from;
         // Each commit moves the floor forward, so this ends within a few ring lengths.
         for _ in 0..4 * HISTORY_RUNS {
@@ -432,7 +459,7 @@ impl<'lib> Recognizer<'lib> {
             match self.decider.offer(best, self.floor) {
                 Decision::Wait => i = i.wrapping_add(1),
                 Decision::Commit(c) => {
-                    self.commit(c, emit);
+                    self.commit(c, out);
                     i = self.floor;
                 }
             }
@@ -525,33 +552,39 @@ impl<'lib> Recognizer<'lib> {
     /// or the next cycle of a cyclic one could still change it. A consumer has the likely
     /// answer after the usual pause instead of after the hold; the commit revises the report
     /// if it did change (see [`ActionEvent::revises`]).
-    fn report_provisional(&mut self, p: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+    fn report_provisional(&mut self, p: Candidate, out: &mut impl Sink) {
         if self.provisional.is_some() {
             return;
         }
         let before = self.held;
-        if let Some((ev, continues, held)) = self.outcome(&p, before) {
+        if let Ok((ev, continues, held)) = self.outcome(&p, before) {
             self.provisional = Some((p, before, continues));
             self.held = held;
             self.report_floor = self.phrase_floor;
             self.phrase_floor = (p.end.wrapping_add(1), false);
-            self.emit_held(ev, continues, emit);
+            self.emit_held(ev, continues, out);
         }
     }
 
     /// What committing `c` after the held event `held` emits — the event, and whether it
-    /// continues (revises) `held` — and the held event after it ([`crate::follow`]). None
-    /// when `c` is too brief, is the held event's settling, or is a new event whose motion
-    /// did not go as far as its action's examples ([`far_enough`]: a fidget).
-    fn outcome(&self, c: &Candidate, held: Option<Held>) -> Option<(Held, bool, Option<Held>)> {
+    /// continues (revises) `held` — and the held event after it ([`crate::follow`]); or why
+    /// there is none: `c` is too brief, is the held event's settling, or is a new event whose
+    /// motion did not go as far as its action's examples ([`far_enough`]: a fidget).
+    fn outcome(
+        &self,
+        c: &Candidate,
+        held: Option<Held>,
+    ) -> Result<(Held, bool, Option<Held>), Why> {
         let (ev, (from, to)) = self.event_of(c)?;
         // Only a new event is held to its action's extent; a continuation's went before. A
         // fidget seems to go as far as the tracker's noise takes it besides.
         let hist = self.front.history();
         let noise = noise_reach(self.front.noise_rms());
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
-            Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => None,
-            _ => Some((ev, false, Some(ev))),
+            Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => {
+                Err(Why::NotFarEnough)
+            }
+            _ => Ok((ev, false, Some(ev))),
         };
         let Some(mut h) = held else {
             return new(ev);
@@ -565,7 +598,7 @@ impl<'lib> Recognizer<'lib> {
                 .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
         match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
-            Follow::Settles => return None,
+            Follow::Settles => return Err(Why::Settles),
             Follow::Continues => h.distance = h.distance.max(c.distance()),
             Follow::Completes(cost) => {
                 h.cost = cost;
@@ -575,15 +608,15 @@ impl<'lib> Recognizer<'lib> {
         h.end = ev.end;
         h.end_run = c.end;
         h.acc.merge(&ev.acc);
-        Some((h, true, Some(h)))
+        Ok((h, true, Some(h)))
     }
 
-    /// The event `c` would be, and the runs of its motion phrase (None when its runs are gone
-    /// or it is too brief to be a gesture).
-    fn event_of(&self, c: &Candidate) -> Option<(Held, (u32, u32))> {
+    /// The event `c` would be, and the runs of its motion phrase; or why there is none (its
+    /// runs are gone, or it is too brief to be a gesture).
+    fn event_of(&self, c: &Candidate) -> Result<(Held, (u32, u32)), Why> {
         let hist = self.front.history();
-        let start = hist.get(c.start)?.start;
-        let end = hist.get(c.end)?.end;
+        let start = hist.get(c.start).ok_or(Why::Lost)?.start;
+        let end = hist.get(c.end).ok_or(Why::Lost)?.end;
         if end.1.saturating_sub(start.1) < MIN_ACTION_US
             && hist.accum(c.start, c.end).turn_sum() * TICK_S < BRIEF_TURN_RAD
         {
@@ -591,7 +624,7 @@ impl<'lib> Recognizer<'lib> {
             // gesture is this brief, unless it turned the figurine a quarter turn. (Checked
             // first, before the phrase around the match is gathered for its effort; once per
             // report or commit, not per sample.)
-            return None;
+            return Err(Why::TooBrief);
         }
         // Effort is read over the whole motion phrase around the match — out to the stillness
         // on either side (not before the previous commit) — as in training, where a gesture's
@@ -642,7 +675,21 @@ impl<'lib> Recognizer<'lib> {
             cost: c.cost,
             acc,
         };
-        Some((ev, (from, to)))
+        Ok((ev, (from, to)))
+    }
+
+    /// A note on candidate `c` (None when its runs are gone).
+    fn note_of(&self, c: &Candidate, why: Why) -> Option<Note> {
+        let hist = self.front.history();
+        let (start, end) = (hist.get(c.start)?.start, hist.get(c.end)?.end);
+        Some(Note {
+            action: c.action,
+            start_seq: start.0,
+            start_us: start.1,
+            end_seq: end.0,
+            end_us: end.1,
+            why,
+        })
     }
 
     /// Commits a candidate and emits it: as a new event, as the continuation of the held
@@ -651,20 +698,26 @@ impl<'lib> Recognizer<'lib> {
     /// A cyclic action's event stays held so that its next cycle can continue it. A candidate
     /// whose shape is as unlike its action's as the penalty measures is first offered to
     /// [`reread`].
-    fn commit(&mut self, c: Candidate, emit: &mut impl FnMut(ActionEvent)) {
+    fn commit(&mut self, c: Candidate, out: &mut impl Sink) {
         // After a provisional report, `c` is judged against what the consumer had before it:
         // the held event as it was, if the report continued it; nothing, if the report was a
         // new event (which `c` replaces).
         // A match whose motion is plainly unlike its action's is read as the action whose
         // pattern nearly fits it and whose examples moved as it did, if one does.
-        let c = reread(&self.library, self.front.history(), &c).unwrap_or(c);
+        let c = match reread(&self.library, self.front.history(), &c) {
+            Some(r) => {
+                out.note(|| self.note_of(&r, Why::Reread { matched: c.action }));
+                r
+            }
+            None => c,
+        };
         let provisional = self.provisional.take();
         let before = match provisional {
             Some((_, held, true)) => held,
             Some((_, _, false)) => None,
             None => self.held,
         };
-        let out = self.outcome(&c, before);
+        let outcome = self.outcome(&c, before);
         self.bank.reset();
         self.decider.clear();
         // The pause's answer was about the match now committed: what is pending next is
@@ -673,8 +726,12 @@ impl<'lib> Recognizer<'lib> {
         self.floor = c.end.wrapping_add(1);
         // Its runs are consumed either way; a too-brief one is not emitted (and a report of
         // another candidate stands).
-        let Some((ev, revises, held)) = out else {
-            return;
+        let (ev, revises, held) = match outcome {
+            Ok(o) => o,
+            Err(why) => {
+                out.note(|| self.note_of(&c, why));
+                return;
+            }
         };
         self.phrase_floor = (self.floor, false);
         self.held = held;
@@ -684,15 +741,53 @@ impl<'lib> Recognizer<'lib> {
             // The report extended the held event: put that back, then `c`.
             Some((_, before, true)) => {
                 if let Some(b) = before {
-                    self.emit_held(b, true, emit);
+                    self.emit_held(b, true, out);
                 }
-                self.emit_held(ev, revises, emit);
+                self.emit_held(ev, revises, out);
             }
             // The report was a new event: `c` replaces it.
-            Some((_, _, false)) => self.emit_held(ev, true, emit),
-            None => self.emit_held(ev, revises, emit),
+            Some((_, _, false)) => self.emit_held(ev, true, out),
+            None => self.emit_held(ev, revises, out),
         }
     }
+}
+
+/// Where a recognizer's output goes: events always, notes only when a reader asked.
+trait Sink {
+    /// An event, as [`crate::Recognizer::push`] emits it.
+    fn event(&mut self, e: ActionEvent);
+    /// A note, built by `make` only if it is wanted.
+    fn note(&mut self, make: impl FnOnce() -> Option<Note>);
+}
+
+/// Events to one closure, notes to another.
+struct Noted<E, N> {
+    /// Receives the events.
+    event: E,
+    /// Receives the notes.
+    note: N,
+}
+
+impl<E: FnMut(ActionEvent), N: FnMut(Note)> Sink for Noted<E, N> {
+    fn event(&mut self, e: ActionEvent) {
+        (self.event)(e);
+    }
+    fn note(&mut self, make: impl FnOnce() -> Option<Note>) {
+        if let Some(n) = make() {
+            (self.note)(n);
+        }
+    }
+}
+
+/// Events to a closure; notes not built.
+struct Quiet<E>(E);
+
+impl<E: FnMut(ActionEvent)> Sink for Quiet<E> {
+    fn event(&mut self, e: ActionEvent) {
+        (self.0)(e);
+    }
+    #[inline(always)]
+    fn note(&mut self, _: impl FnOnce() -> Option<Note>) {}
 }
 
 /// Whether an action other than `skip` has `tokens` (at least one) as the start of a match
@@ -767,6 +862,17 @@ mod tests {
         }
         rec.flush(|e| ev.push(e));
         ev
+    }
+
+    /// [`run`] with the decision stage's notes.
+    fn run_noted(lib: &Library<'_>, samples: &[Sample]) -> (Vec<ActionEvent>, Vec<Note>) {
+        let mut rec = Recognizer::new(*lib, None);
+        let (mut ev, mut notes) = (Vec::new(), Vec::new());
+        for s in samples {
+            rec.push_noted(s, |e| ev.push(e), |n| notes.push(n));
+        }
+        rec.flush_noted(|e| ev.push(e), |n| notes.push(n));
+        (ev, notes)
     }
 
     #[test]
@@ -1133,8 +1239,24 @@ mod tests {
         let ev = run(&lib, &quick_strokes(&[left, [0.0, 1.0, 0.0], left]));
         assert_eq!(ev.len(), 1, "{ev:?}");
         assert!(ev[0].start_us < 400_000 && ev[0].end_us > 900_000, "{ev:?}");
-        // A stroke alone stays too brief.
-        assert_eq!(run(&lib, &quick_strokes(&[left])), [], "one stroke");
+        // A stroke alone stays too brief, and the note says so, over the stroke's 0.12 s.
+        let (ev, notes) = run_noted(&lib, &quick_strokes(&[left]));
+        assert_eq!(ev, [], "one stroke");
+        let brief: Vec<&Note> = notes.iter().filter(|n| n.why == Why::TooBrief).collect();
+        assert!(!brief.is_empty(), "{notes:?}");
+        for n in brief {
+            assert!(
+                n.action == 0 && n.start_us >= 250_000 && n.end_us <= 500_000,
+                "{n:?}"
+            );
+        }
+        // Offered to its nearest action first, then dropped all the same: nothing else.
+        assert!(
+            notes
+                .iter()
+                .all(|n| matches!(n.why, Why::TooBrief | Why::Nearest)),
+            "{notes:?}"
+        );
     }
 
     /// A twist about the vertical axis by `angle` rad in 0.12 s, after 0.6 s of stillness and
@@ -1194,7 +1316,12 @@ mod tests {
         // reported; with them it went nowhere near as far as a turn goes.
         let fidget = twists(0.09, 0.06, Some(0.3));
         assert_eq!(run(&unknown, &fidget).len(), 1, "the tokens spell it");
-        assert_eq!(run(&lib, &fidget), []);
+        let (ev, notes) = run_noted(&lib, &fidget);
+        assert_eq!(ev, []);
+        assert!(
+            notes.iter().any(|n| n.why == Why::NotFarEnough),
+            "{notes:?}"
+        );
         // 30° there and back: a turn played small, but played.
         let ev = run(&lib, &twists(0.5, 0.06, Some(0.3)));
         assert_eq!(ev.len(), 1, "{ev:?}");
@@ -1367,17 +1494,25 @@ mod tests {
             let blob = seq_library(&[(&["uf", "df"], 0), (&["u", "d", "u"], 1), (&["f.Yp"], 0)]);
             let lib = Library::from_bytes(&blob).unwrap();
             let mut rec = Recognizer::new(lib, None);
-            let mut events = 0u32;
+            let mut events = Vec::new();
             for s in &stream {
                 rec.push(s, |e| {
                     assert!(e.end_us >= e.start_us);
-                    events += 1;
+                    events.push(e);
                 });
             }
-            rec.flush(|_| events += 1);
+            rec.flush(|e| events.push(e));
             let st = rec.stats();
             prop_assert_eq!((st.intake.accepted + st.intake.skipped()) as usize, stream.len());
-            prop_assert_eq!(st.events, events);
+            prop_assert_eq!(st.events as usize, events.len());
+            // Asking for notes changes no event.
+            let mut noted = Recognizer::new(lib, None);
+            let mut again = Vec::new();
+            for s in &stream {
+                noted.push_noted(s, |e| again.push(e), |n| assert!(n.end_us >= n.start_us));
+            }
+            noted.flush_noted(|e| again.push(e), |_| {});
+            prop_assert_eq!(events, again);
         }
     }
 }

@@ -12,7 +12,7 @@ use figurine_recognizer::features::Accum;
 use figurine_recognizer::frontend::{FrontEvent, Frontend};
 use figurine_recognizer::history::Run;
 use figurine_recognizer::token::STILL;
-use figurine_recognizer::{ActionEvent, EffortModel, Library, Recognizer, Sample};
+use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Sample};
 
 use crate::events::fold_revision;
 use crate::poselog::PoseLog;
@@ -98,6 +98,28 @@ pub fn recognize_log(rec: &mut Recognizer<'_>, samples: &[(usize, Sample)]) -> V
     }
     rec.flush(|e| fold_revision(&mut events, e, e.revises));
     events
+}
+
+/// [`recognize_log`], and the decision stage's notes on the matches it dropped or re-read
+/// ([`figurine_recognizer::note`]), in the order they were made.
+pub fn recognize_log_noted(
+    rec: &mut Recognizer<'_>,
+    samples: &[(usize, Sample)],
+) -> (Vec<ActionEvent>, Vec<Note>) {
+    let mut events = Vec::new();
+    let mut notes = Vec::new();
+    for (_, s) in samples {
+        rec.push_noted(
+            s,
+            |e| fold_revision(&mut events, e, e.revises),
+            |n| notes.push(n),
+        );
+    }
+    rec.flush_noted(
+        |e| fold_revision(&mut events, e, e.revises),
+        |n| notes.push(n),
+    );
+    (events, notes)
 }
 
 /// The events each library's recognizer reports on `log`, as [`recognize_log`] gives them

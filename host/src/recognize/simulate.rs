@@ -3,17 +3,20 @@
 //! Output: with `--jsonl`, one `figurine_host::events::ActionRecord` JSON object per action
 //! (start/end in seconds of the log's clock, time/weight = the device's i8 values / 127, so
 //! host and device agree bit for bit); otherwise a readable table and a summary of skipped
-//! input. Without `--effort`, the shipped default effort model is used.
+//! input, and with `--why` the matches the decision stage dropped or read as another action,
+//! each with the rule that decided it ([`figurine_recognizer::note`]). Without `--effort`,
+//! the shipped default effort model is used.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use figurine_recognizer::{ActionEvent, EffortModel, Library, Recognizer, Stats};
+use figurine_recognizer::segment::{BRIEF_TURN_RAD, MIN_ACTION_US};
+use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Stats, Why};
 
 use super::effort_model::EffortFile;
-use super::feed::{log_samples, recognize_log, Clock};
+use super::feed::{log_samples, recognize_log_noted, Clock};
 use super::library::LibraryFile;
 use crate::events::{write_event, ActionRecord};
 use crate::poselog::PoseLog;
@@ -30,6 +33,11 @@ pub struct SimulateArgs {
     /// Print one JSON object per recognised action instead of a table.
     #[arg(long)]
     pub jsonl: bool,
+    /// Also print why: every match the decision stage dropped (too brief, not as far as its
+    /// action's examples went, the settling of the event before it) or reported as another
+    /// action, with the rule that decided it.
+    #[arg(long, conflicts_with = "jsonl")]
+    pub why: bool,
     /// The pose log (CSV).
     pub log: PathBuf,
 }
@@ -41,6 +49,10 @@ pub struct Simulation {
     pub records: Vec<ActionRecord>,
     /// The raw device events.
     pub events: Vec<ActionEvent>,
+    /// The decision stage's notes: matches dropped or read as another action, in order.
+    pub notes: Vec<Note>,
+    /// The log's clock, for the notes' sequence numbers.
+    pub clock: Clock,
     /// Recognizer statistics.
     pub stats: Stats,
     /// Log samples the wire could not carry.
@@ -68,10 +80,7 @@ pub fn load_effort(path: Option<&Path>) -> Result<EffortModel> {
 /// Converts a device event to the host record.
 pub fn to_record(e: &ActionEvent, names: &[String], clock: &Clock) -> ActionRecord {
     ActionRecord {
-        action: names
-            .get(usize::from(e.action))
-            .cloned()
-            .unwrap_or_else(|| format!("#{}", e.action)),
+        action: name_of(names, e.action),
         start: clock.time_of(e.start_seq),
         end: clock.time_of(e.end_seq),
         time: f64::from(e.time_q) / 127.0,
@@ -91,11 +100,13 @@ pub fn simulate_log(
         Library::from_bytes(blob).map_err(|e| anyhow::anyhow!("library blob refused: {e}"))?;
     let mut rec = Recognizer::new(library, effort);
     let (samples, unsendable) = log_samples(log);
-    let events = recognize_log(&mut rec, &samples);
+    let (events, notes) = recognize_log_noted(&mut rec, &samples);
     let clock = Clock::new(log, &samples);
     Ok(Simulation {
         records: events.iter().map(|e| to_record(e, names, &clock)).collect(),
         events,
+        notes,
+        clock,
         stats: rec.stats(),
         unsendable,
     })
@@ -148,9 +159,80 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             s.intake.gaps,
             sim.unsendable
         )?;
+        if args.why {
+            write_notes(
+                &mut out,
+                &sim.notes,
+                &lib.names(),
+                &Clock::new(&log, &log_samples(&log).0),
+            )?;
+        }
     }
     out.flush()?;
     Ok(())
+}
+
+/// The notes as `simulate --why` prints them: one line per note, on the log's clock (a phrase
+/// weighed again at a later pause or at the end of the log, and decided alike, once).
+pub fn write_notes(
+    mut out: impl Write,
+    notes: &[Note],
+    names: &[String],
+    clock: &Clock,
+) -> Result<()> {
+    if notes.is_empty() {
+        writeln!(
+            out,
+            "why: every match committed was reported as its pattern's action"
+        )?;
+        return Ok(());
+    }
+    writeln!(out, "why (matches dropped or read as another action):")?;
+    let mut seen = std::collections::HashSet::new();
+    for n in notes.iter().filter(|n| seen.insert(**n)) {
+        writeln!(
+            out,
+            "{:<12} {:>9.3} {:>9.3}  {}",
+            name_of(names, n.action),
+            clock.time_of(n.start_seq),
+            clock.time_of(n.end_seq),
+            why_words(n, names)
+        )?;
+    }
+    Ok(())
+}
+
+fn name_of(names: &[String], a: u8) -> String {
+    names
+        .get(usize::from(a))
+        .cloned()
+        .unwrap_or_else(|| format!("#{a}"))
+}
+
+/// What a note says, in words.
+pub fn why_words(n: &Note, names: &[String]) -> String {
+    let action = name_of(names, n.action);
+    match n.why {
+        Why::TooBrief => format!(
+            "dropped: briefer than {:.2} s and turned less than {:.0}° (a flicker)",
+            MIN_ACTION_US as f64 * 1e-6,
+            f64::from(BRIEF_TURN_RAD).to_degrees()
+        ),
+        Why::NotFarEnough => format!(
+            "dropped: a new event that went (or travelled) less far than `{action}`'s \
+             examples allow (a fidget)"
+        ),
+        Why::Settles => "dropped: the settling of the event before it".into(),
+        Why::Lost => "dropped: its motion had left the recognizer's history".into(),
+        Why::Reread { matched } => format!(
+            "read as `{action}`: `{}`'s pattern matched, but it moved unlike its \
+             examples and like `{action}`'s",
+            name_of(names, matched)
+        ),
+        Why::Nearest => format!(
+            "offered to `{action}`, its nearest action: no event took this stand-alone phrase"
+        ),
+    }
 }
 
 /// "sudden-strong" style words for a (Lt, Lw) pair.

@@ -1,0 +1,59 @@
+//! Stage 6, told — why the decision stage dropped or changed a match, for a reader.
+//!
+//! A user whose crouch was not reported, or was reported as a bow, wants to know which rule
+//! decided it. [`crate::Recognizer::push_noted`] hands out a [`Note`] wherever a committed
+//! match did not become the event its pattern named:
+//!
+//! | [`Why`] | rule | where |
+//! |---|---|---|
+//! | [`Why::TooBrief`] | briefer than [`crate::segment::MIN_ACTION_US`], turned less than [`crate::segment::BRIEF_TURN_RAD`]: a flicker | segment |
+//! | [`Why::NotFarEnough`] | a new event that went less far (or, for an action whose examples travelled, ended less far away) than its action's examples allow: a fidget | [`crate::extent`] |
+//! | [`Why::Settles`] | the settling of the event before it, which moved much more | [`crate::follow`] |
+//! | [`Why::Lost`] | its token runs had already left the history | [`crate::history`] |
+//! | [`Why::Reread`] | its motion was plainly unlike its action's examples: reported as the action it moved like | [`crate::nearest`] |
+//! | [`Why::Nearest`] | a stand-alone phrase no pattern matched closely: reported as its nearest action | [`crate::nearest`] |
+//!
+//! The notes change nothing: [`crate::Recognizer::push`] is `push_noted` with notes thrown
+//! away, and a note is only built when it is asked for (the device builds none).
+// No imports: the recognizer hands notes out, so this module must not depend on it.
+
+/// Why a match was dropped, or reported as another action than its pattern's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Why {
+    /// Dropped: briefer than the least action and not turned a quarter turn.
+    TooBrief,
+    /// Dropped: a new event that did not go (or travel) as far as its action's examples.
+    NotFarEnough,
+    /// Dropped: the settling of the event before it.
+    Settles,
+    /// Dropped: its runs had left the history before it was committed.
+    Lost,
+    /// Reported as [`Note::action`], though the pattern of action `matched` matched it: it
+    /// moved unlike `matched`'s examples and like the reported action's.
+    Reread {
+        /// The action whose pattern matched.
+        matched: u8,
+    },
+    /// Reported as [`Note::action`], its nearest action: a stand-alone phrase no pattern
+    /// matched within its bound.
+    Nearest,
+}
+
+/// One decision about a match, with the span of its token runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Note {
+    /// The action (library index) the match was, or became.
+    pub action: u8,
+    /// Sequence number of the sample that opened the match's first run.
+    pub start_seq: u32,
+    /// Time of that sample, µs.
+    pub start_us: u64,
+    /// Sequence number of the sample that closed its last run.
+    pub end_seq: u32,
+    /// Time of that sample, µs.
+    pub end_us: u64,
+    /// What was decided.
+    pub why: Why,
+}
