@@ -1,0 +1,442 @@
+//! Stage 6b — what a committed match becomes: a new event, the next piece of the one before,
+//! its settling, or nothing.
+//!
+//! A candidate the decision stage commits is first re-read when it moved plainly unlike its
+//! action ([`crate::nearest::reread`]), then weighed against the event before it
+//! ([`crate::follow`]) and, when new, against how far its action's examples went
+//! ([`crate::extent`]); a match too brief for any gesture is none. A candidate held at a
+//! pause is reported early ([`Recognizer::report_provisional`]) and revised by the commit if
+//! it changed. Each drop, and each re-read, is a [`Note`] for a reader who asks.
+
+use crate::alignment::FULL;
+use crate::bayes::quantise;
+use crate::extent::{far_enough, noise_reach, span_extent};
+use crate::features::segment_features;
+use crate::follow::{follow, Follow, Held};
+use crate::history::HISTORY_RUNS;
+use crate::intake::TICK_S;
+use crate::nearest::reread;
+use crate::note::{Note, Why};
+use crate::segment::{Candidate, BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
+use crate::token::STILL;
+
+use super::{ActionEvent, Recognizer, Sink};
+
+impl<'lib> Recognizer<'lib> {
+    /// Reports the pending candidate `p` before it is committed (once): the figurine has
+    /// paused after it for as long as commits an action, and only a longer action in progress
+    /// or the next cycle of a cyclic one could still change it. A consumer has the likely
+    /// answer after the usual pause instead of after the hold; the commit revises the report
+    /// if it did change (see [`ActionEvent::revises`]).
+    pub(super) fn report_provisional(&mut self, p: Candidate, out: &mut impl Sink) {
+        if self.provisional.is_some() {
+            return;
+        }
+        let before = self.held;
+        if let Ok((ev, continues, held)) = self.outcome(&p, before) {
+            self.provisional = Some((p, before, continues));
+            self.held = held;
+            self.report_floor = self.phrase_floor;
+            self.phrase_floor = (p.end.wrapping_add(1), false);
+            self.emit_held(ev, continues, out);
+        }
+    }
+
+    /// What committing `c` after the held event `held` emits — the event, and whether it
+    /// continues (revises) `held` — and the held event after it ([`crate::follow`]); or why
+    /// there is none: `c` is too brief, is the held event's settling, or is a new event whose
+    /// motion did not go as far as its action's examples ([`far_enough`]: a fidget).
+    pub(super) fn outcome(
+        &self,
+        c: &Candidate,
+        held: Option<Held>,
+    ) -> Result<(Held, bool, Option<Held>), Why> {
+        let (ev, (from, to)) = self.event_of(c)?;
+        // Only a new event is held to its action's extent; a continuation's went before. A
+        // fidget seems to go as far as the tracker's noise takes it besides.
+        let hist = self.front.history();
+        let noise = noise_reach(self.front.noise_rms());
+        let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
+            Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => {
+                Err(Why::NotFarEnough)
+            }
+            _ => Ok((ev, false, Some(ev))),
+        };
+        let Some(mut h) = held else {
+            return new(ev);
+        };
+        // Past the usual pause, only the rest of a hold its action's examples made (a crouch
+        // held low, then risen from) continues it.
+        let gap = c.start.wrapping_sub(h.end_run);
+        let late = gap <= HISTORY_RUNS as u32
+            && (1..gap)
+                .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
+                .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
+        match follow(&self.library, hist, &h, c, late) {
+            Follow::New => return new(ev),
+            Follow::Settles => return Err(Why::Settles),
+            Follow::Continues => h.distance = h.distance.max(c.distance()),
+            Follow::Completes(cost) => {
+                h.cost = cost;
+                h.distance = cost.div_ceil(FULL);
+            }
+        }
+        h.end = ev.end;
+        h.end_run = c.end;
+        h.acc.merge(&ev.acc);
+        Ok((h, true, Some(h)))
+    }
+
+    /// The event `c` would be, and the runs of its motion phrase; or why there is none (its
+    /// runs are gone, or it is too brief to be a gesture).
+    pub(super) fn event_of(&self, c: &Candidate) -> Result<(Held, (u32, u32)), Why> {
+        let hist = self.front.history();
+        let start = hist.get(c.start).ok_or(Why::Lost)?.start;
+        let end = hist.get(c.end).ok_or(Why::Lost)?.end;
+        if end.1.saturating_sub(start.1) < MIN_ACTION_US
+            && hist.accum(c.start, c.end).turn_sum() * TICK_S < BRIEF_TURN_RAD
+        {
+            // A flicker of a token or two that happens to spell a short pattern: no child's
+            // gesture is this brief, unless it turned the figurine a quarter turn. (Checked
+            // first, before the phrase around the match is gathered for its effort; once per
+            // report or commit, not per sample.)
+            return Err(Why::TooBrief);
+        }
+        // Effort is read over the whole motion phrase around the match — out to the stillness
+        // on either side (not before the previous commit) — as in training, where a gesture's
+        // features span all of its motion.
+        let mut from = c.start;
+        for _ in 0..HISTORY_RUNS {
+            let prev = from.wrapping_sub(1);
+            if prev.wrapping_sub(self.floor) > c.start.wrapping_sub(self.floor) {
+                break;
+            }
+            match hist.get(prev) {
+                Some(r) if r.token != STILL => from = prev,
+                _ => break,
+            }
+        }
+        let mut to = c.end;
+        if let Some(newest) = hist.newest() {
+            for _ in 0..HISTORY_RUNS {
+                if to == newest {
+                    break;
+                }
+                match hist.get(to.wrapping_add(1)) {
+                    Some(r) if r.token != STILL => to = to.wrapping_add(1),
+                    _ => break,
+                }
+            }
+        }
+        let acc = hist.accum(from, to);
+        // Reported from where the figurine set off from the rest before the match to where it
+        // settled in the rest after it (or, still settling, to now): a slow onset or settle
+        // below the "moving" threshold is part of the action.
+        let start = hist
+            .get(c.start.wrapping_sub(1))
+            .filter(|r| r.token == STILL)
+            .and_then(|r| r.set_off())
+            .unwrap_or(start);
+        let end = match hist.get(c.end.wrapping_add(1)) {
+            Some(r) if r.token == STILL => r.settled().unwrap_or(r.end),
+            _ => end,
+        };
+        let ev = Held {
+            action: c.action,
+            start_run: c.start,
+            start,
+            end,
+            end_run: c.end,
+            distance: c.distance(),
+            cost: c.cost,
+            acc,
+        };
+        Ok((ev, (from, to)))
+    }
+
+    /// A note on candidate `c` (None when its runs are gone).
+    pub(super) fn note_of(&self, c: &Candidate, why: Why) -> Option<Note> {
+        let hist = self.front.history();
+        let (start, end) = (hist.get(c.start)?.start, hist.get(c.end)?.end);
+        Some(Note {
+            action: c.action,
+            start_seq: start.0,
+            start_us: start.1,
+            end_seq: end.0,
+            end_us: end.1,
+            why,
+        })
+    }
+
+    /// Commits a candidate and emits it: as a new event, as the continuation of the held
+    /// cyclic one (the next cycle after a short pause), or as the revision of the provisional
+    /// report of another candidate it took over (nothing, when it is that reported candidate).
+    /// A cyclic action's event stays held so that its next cycle can continue it. A candidate
+    /// whose shape is as unlike its action's as the penalty measures is first offered to
+    /// [`reread`].
+    pub(super) fn commit(&mut self, c: Candidate, out: &mut impl Sink) {
+        // After a provisional report, `c` is judged against what the consumer had before it:
+        // the held event as it was, if the report continued it; nothing, if the report was a
+        // new event (which `c` replaces).
+        // A match whose motion is plainly unlike its action's is read as the action whose
+        // pattern nearly fits it and whose examples moved as it did, if one does.
+        let c = match reread(&self.library, self.front.history(), &c) {
+            Some(r) => {
+                out.note(|| self.note_of(&r, Why::Reread { matched: c.action }));
+                r
+            }
+            None => c,
+        };
+        let provisional = self.provisional.take();
+        let before = match provisional {
+            Some((_, held, true)) => held,
+            Some((_, _, false)) => None,
+            None => self.held,
+        };
+        let outcome = self.outcome(&c, before);
+        self.bank.reset();
+        self.decider.clear();
+        // The pause's answer was about the match now committed: what is pending next is
+        // weighed afresh.
+        self.hold = None;
+        self.floor = c.end.wrapping_add(1);
+        // Its runs are consumed either way; a too-brief one is not emitted (and a report of
+        // another candidate stands).
+        let (ev, revises, held) = match outcome {
+            Ok(o) => o,
+            Err(why) => {
+                out.note(|| self.note_of(&c, why));
+                return;
+            }
+        };
+        self.phrase_floor = (self.floor, false);
+        self.held = held;
+        match provisional {
+            // Reported already, exactly so.
+            Some((pv, _, _)) if pv == c => {}
+            // The report extended the held event: put that back, then `c`.
+            Some((_, before, true)) => {
+                if let Some(b) = before {
+                    self.emit_held(b, true, out);
+                }
+                self.emit_held(ev, revises, out);
+            }
+            // The report was a new event: `c` replaces it.
+            Some((_, _, false)) => self.emit_held(ev, true, out),
+            None => self.emit_held(ev, revises, out),
+        }
+    }
+
+    pub(super) fn emit_held(&mut self, h: Held, revises: bool, out: &mut impl Sink) {
+        let (lt, lw) = match &self.effort {
+            Some(m) => m.classify(&segment_features(&h.acc)),
+            None => (0.0, 0.0),
+        };
+        out.event(ActionEvent {
+            action: h.action,
+            start_seq: h.start.0,
+            start_us: h.start.1,
+            end_seq: h.end.0,
+            end_us: h.end.1,
+            time_q: quantise(lt),
+            weight_q: quantise(lw),
+            distance: h.distance,
+            decided_seq: self.now_seq,
+            decided_us: self.now_us,
+            revises,
+        });
+        self.events = self.events.saturating_add(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::super::fixtures::*;
+    use super::*;
+    use crate::pattern::tests::seq_library;
+    use crate::pattern::Library;
+    use crate::token::Token;
+    use std::vec::Vec;
+
+    #[test]
+    fn the_next_cycle_after_a_short_pause_continues_the_event() {
+        let blob = hop_library(true);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // 350 ms between hops: longer than the stillness that commits a cycle
+        // (`CYCLIC_PAUSE_US`), shorter than the one that ends the action (`CONTINUE_US`).
+        let ev = run(&lib, &paused_hops(3, 0.35));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, true, true],
+            "{ev:?}"
+        );
+        // Each continuation keeps the start, reaches further, and is decided later.
+        for w in ev.windows(2) {
+            assert_eq!(w[1].start_us, w[0].start_us);
+            assert!(w[1].end_us > w[0].end_us + 500_000);
+            assert!(w[1].decided_us > w[0].decided_us);
+        }
+        // The first cycle is reported without waiting for the others, after the usual pause
+        // rather than the longer one that commits a cycle.
+        assert!(ev[0].decided_us < ev[1].end_us);
+        assert!(
+            ev[0].decided_us - ev[0].end_us < crate::segment::CYCLIC_PAUSE_US,
+            "{ev:?}"
+        );
+    }
+
+    #[test]
+    fn a_next_cycle_of_many_runs_still_continues_the_event() {
+        // A cycle of two hops (`(uf f df uf f df)+`): the next cycle is some nine runs after
+        // the last one's end by the time it is matched.
+        let syms: Vec<Token> = ["uf", "f", "df", "uf", "f", "df"]
+            .iter()
+            .map(|t| crate::token::parse_token(t).unwrap())
+            .collect();
+        // Each position may repeat (`uf+ f+ df+ …`), as in `hop_library`.
+        let mut follow: Vec<u64> = (0..=6u32).map(|i| (1 << i) | (1 << (i + 1))).collect();
+        follow[0] = 1 << 1;
+        follow[6] = (1 << 6) | (1 << 1);
+        let mut blob = Vec::from(*b"FGL\x01");
+        blob.extend([1, 0, 0, 0]);
+        // One edit: each hop begins with a brief `u`, extra inside the cycle.
+        crate::pattern::encode_record(&mut blob, &syms, &follow, 1 << 6, 1, true).unwrap();
+        let lib = Library::from_bytes(&blob).unwrap();
+        // 450 ms between hops: a cycle is committed (`CYCLIC_PAUSE_US`) before the next one
+        // begins, and the action goes on (`CONTINUE_US`).
+        let ev = run(&lib, &paused_hops(4, 0.45));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, true],
+            "{ev:?}"
+        );
+        assert_eq!(ev[1].start_us, ev[0].start_us);
+    }
+
+    #[test]
+    fn a_long_pause_or_a_one_shot_action_starts_a_new_event() {
+        let cyclic = hop_library(true);
+        let lib = Library::from_bytes(&cyclic).unwrap();
+        let ev = run(&lib, &paused_hops(2, 0.9));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, false]
+        );
+        // A one-shot action repeated after a short pause is two actions.
+        let once = hop_library(false);
+        let lib = Library::from_bytes(&once).unwrap();
+        let ev = run(&lib, &paused_hops(2, 0.35));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, false]
+        );
+        assert!(ev[1].start_us > ev[0].end_us);
+    }
+
+    #[test]
+    fn a_slow_stroke_is_reported_from_rest_to_rest() {
+        let blob = seq_library(&[(&["f"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &slow_stroke());
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        // It moved from 1.0 s to 2.2 s; fast enough to make a token only from about 1.2 s to
+        // 2.0 s.
+        assert!((900_000..1_120_000).contains(&ev[0].start_us), "{ev:?}");
+        assert!((2_080_000..2_300_000).contains(&ev[0].end_us), "{ev:?}");
+    }
+
+    #[test]
+    fn strokes_too_brief_for_a_gesture_stay_in_their_phrase() {
+        // Each `l` alone matches but is too brief to emit; the `u` between matches nothing.
+        // The three strokes, right after the stream began, are one phrase: its nearest action.
+        let blob = seq_library(&[(&["l"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let left = [1.0, 0.0, 0.0];
+        let ev = run(&lib, &quick_strokes(&[left, [0.0, 1.0, 0.0], left]));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        assert!(ev[0].start_us < 400_000 && ev[0].end_us > 900_000, "{ev:?}");
+        // A stroke alone stays too brief, and the note says so, over the stroke's 0.12 s.
+        let (ev, notes) = run_noted(&lib, &quick_strokes(&[left]));
+        assert_eq!(ev, [], "one stroke");
+        let brief: Vec<&Note> = notes.iter().filter(|n| n.why == Why::TooBrief).collect();
+        assert!(!brief.is_empty(), "{notes:?}");
+        for n in brief {
+            assert!(
+                n.action == 0 && n.start_us >= 250_000 && n.end_us <= 500_000,
+                "{n:?}"
+            );
+        }
+        // Offered to its nearest action first, then dropped all the same: nothing else.
+        assert!(
+            notes
+                .iter()
+                .all(|n| matches!(n.why, Why::TooBrief | Why::Nearest)),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn a_sudden_turn_briefer_than_any_gesture_is_still_one() {
+        let blob = seq_library(&[(&[".Yp"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // Two thirds of a right angle in 0.12 s: a flicker as far as brevity goes …
+        assert_eq!(run(&lib, &quick_twist(1.0)), []);
+        // … a half turn is a turn.
+        let ev = run(&lib, &quick_twist(core::f32::consts::PI));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        // Reported from rest to rest: the twist (0.6 s … 0.72 s), widened by no more than the
+        // filter's half window on either side.
+        let half = crate::filter::SG_HALF as u64 * crate::intake::TICK_US;
+        let (s, e) = (ev[0].start_us, ev[0].end_us);
+        assert!(s <= 600_000 && s + half >= 600_000, "{ev:?}");
+        assert!(e >= 720_000 && e <= 720_000 + 2 * half, "{ev:?}");
+    }
+
+    #[test]
+    fn a_fidget_that_spells_an_action_is_no_action() {
+        // A yaw there and back, learnt from examples that turned at least 1.6 rad (and moved
+        // a centimetre).
+        let blob = seq_library(&[(&[".Yp", ".Yn"], 0)]);
+        let unknown = Library::from_bytes(&blob).unwrap();
+        let learnt = crate::pattern::tests::with_extents(&blob, &[(0.01, 1.6)]);
+        let lib = Library::from_bytes(&learnt).unwrap();
+        // 5° there and back spells it: with no extents learnt (a version 1 library) it is
+        // reported; with them it went nowhere near as far as a turn goes.
+        let fidget = twists(0.09, 0.06, Some(0.3));
+        assert_eq!(run(&unknown, &fidget).len(), 1, "the tokens spell it");
+        let (ev, notes) = run_noted(&lib, &fidget);
+        assert_eq!(ev, []);
+        assert!(
+            notes.iter().any(|n| n.why == Why::NotFarEnough),
+            "{notes:?}"
+        );
+        // 30° there and back: a turn played small, but played.
+        let ev = run(&lib, &twists(0.5, 0.06, Some(0.3)));
+        assert_eq!(ev.len(), 1, "{ev:?}");
+    }
+
+    #[test]
+    fn an_action_reported_during_a_hold_is_revised_by_the_longer_one() {
+        // "thrust" is the forward stroke alone; "jab" is the stroke and its return.
+        let blob = seq_library(&[(&["f"], 0), (&["f", "b"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let ev = run(&lib, &thrust_and_return(0.3));
+        assert_eq!(
+            ev.iter().map(|e| (e.action, e.revises)).collect::<Vec<_>>(),
+            [(0, false), (1, true)],
+            "{ev:?}"
+        );
+        // The thrust is out during the pause, before the return began; the jab replaces it.
+        assert!(ev[0].decided_us < 1_300_000, "{ev:?}");
+        assert_eq!(ev[1].start_us, ev[0].start_us);
+        assert!(ev[1].end_us > ev[0].end_us + 300_000);
+        // Held past HOLD_US: the thrust stands alone, and the return is no jab.
+        let ev = run(&lib, &thrust_and_return(0.9));
+        assert_eq!(
+            ev.iter().map(|e| (e.action, e.revises)).collect::<Vec<_>>(),
+            [(0, false)],
+            "{ev:?}"
+        );
+    }
+}
