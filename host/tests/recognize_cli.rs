@@ -336,3 +336,50 @@ fn simulate_why_names_the_rule_that_dropped_a_match() {
     let out = figurine(&["simulate", "--why", "--jsonl", flick.to_str().unwrap()]);
     assert!(!out.status.success());
 }
+
+/// `eval --verbose` names every misread gesture with the command that plays it again — under
+/// the evaluation's own tracker — and says why the decision stage dropped what it dropped.
+#[test]
+fn eval_verbose_hints_regenerate_the_misread_gesture() {
+    let out = figurine(&["eval", "--noise", "3", "--sequences", "1", "--verbose"]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err.lines().collect();
+    let hints: Vec<(usize, &str)> = lines
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let at = l.find("(figurine synth examples ")?;
+            Some((i, l[at + 1..].trim_end_matches(')')))
+        })
+        .collect();
+    assert!(!hints.is_empty(), "no misread at noise ×3?\n{err}");
+    // The first hint with an event: the gesture's span is printed beside it.
+    let (i, hint) = hints
+        .iter()
+        .copied()
+        .find(|(i, _)| lines.get(i + 1).is_some_and(|l| l.contains("(gesture ")))
+        .expect("a misread with an event");
+    assert!(hint.ends_with("--noise 3"), "{hint}");
+    let span = lines[i + 1].split("(gesture ").nth(1).unwrap();
+    let (a, b) = span.trim_end_matches(')').split_once('-').unwrap();
+    let d = tmp("hint");
+    let args: Vec<&str> = hint.split_whitespace().skip(1).collect();
+    let mut cmd = args.clone();
+    cmd.extend(["--out", d.to_str().unwrap()]);
+    let again = figurine(&cmd);
+    assert!(again.status.success(), "{hint}");
+    // `synth examples` prints the label it wrote: the same span, to the hundredth.
+    let said = String::from_utf8_lossy(&again.stdout);
+    let label = said.lines().find(|l| l.contains(" .. ")).unwrap_or("");
+    let nums: Vec<f64> = label
+        .split_whitespace()
+        .filter_map(|w| w.parse::<f64>().ok())
+        .collect();
+    let [t0, t1] = nums[..] else { panic!("{said}") };
+    assert_eq!(
+        (format!("{t0:.2}"), format!("{t1:.2}")),
+        (a.to_string(), b.to_string()),
+        "{hint}: {said}"
+    );
+}

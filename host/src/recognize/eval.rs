@@ -27,7 +27,7 @@ use super::effort_train::{gesture_features, train, Example, Trained};
 use super::feed::{log_samples, recognize_log, Clock};
 use super::learn::learn_action;
 use super::library::LibraryFile;
-use super::simulate::load_effort;
+use super::simulate::{load_effort, note_lines, simulate_log, NoteLine};
 use crate::synth::{self, Action, Doodle, Handling, Knobs, Label, Range, TimeClass, WeightClass};
 use figurine_recognizer::{EffortModel, Library, Recognizer};
 
@@ -204,6 +204,18 @@ pub fn run_doodle(
             weight: f64::from(e.weight_q) / 127.0,
         })
         .collect())
+}
+
+/// `eval --verbose`'s account of a doodle: the decision stage's notes on it
+/// ([`super::simulate::note_lines`]).
+fn notes_of(
+    d: &Doodle,
+    names: &[String],
+    blob: &[u8],
+    effort: EffortModel,
+) -> Result<Vec<NoteLine>> {
+    let sim = simulate_log(&d.log, names, blob, Some(effort))?;
+    Ok(note_lines(&sim.notes, names, &sim.clock))
 }
 
 fn overlap(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
@@ -396,19 +408,26 @@ pub fn evaluate(
                     );
                     eprintln!(
                         "    played at {:.0} Hz, scale {:.2}, speed {:.2}, noise {:.2}, {:?}/{:?} \
-                         (figurine synth examples --action {} --count 1 --seed {seed})",
+                         (figurine synth examples --action {} --count 1 --seed {seed}{})",
                         v.rate_hz,
                         v.scale,
                         v.speed,
                         v.noise,
                         l.time_class,
                         l.weight_class,
-                        l.action
+                        l.action,
+                        args.knob_flags()
                     );
                     for e in &evs {
                         eprintln!(
                             "    event {} {:.2}-{:.2} (gesture {:.2}-{:.2})",
                             e.action, e.start, e.end, l.start, l.end
+                        );
+                    }
+                    for n in notes_of(&d, &names, &blob, effort)? {
+                        eprintln!(
+                            "    why: {} {:.2}-{:.2}: {}",
+                            n.action, n.start, n.end, n.words
                         );
                     }
                 }
@@ -491,6 +510,15 @@ pub fn evaluate(
                     "  sequence {k}: missed {} {:.2}-{:.2}",
                     l.action, l.start, l.end
                 );
+                for n in notes_of(&d, &names, &blob, effort)?
+                    .iter()
+                    .filter(|n| overlap(n.start, n.end, l.start, l.end) > 0.0)
+                {
+                    eprintln!(
+                        "    why: {} {:.2}-{:.2}: {}",
+                        n.action, n.start, n.end, n.words
+                    );
+                }
             }
         }
         for (e, _) in evs.iter().zip(&used).filter(|(_, u)| !**u) {

@@ -172,15 +172,45 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-/// The notes as `simulate --why` prints them: one line per note, on the log's clock (a phrase
-/// weighed again at a later pause or at the end of the log, and decided alike, once).
+/// A note in a reader's terms: its action's name, its span in seconds on the log's clock,
+/// and what was decided ([`why_words`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoteLine {
+    /// The action the match was, or became.
+    pub action: String,
+    /// Start of its first run, s.
+    pub start: f64,
+    /// End of its last run, s.
+    pub end: f64,
+    /// What was decided, in words.
+    pub words: String,
+}
+
+/// The notes of a simulation in a reader's terms, each once (a phrase weighed again at a
+/// later pause or at the end of the log, and decided alike, is one line).
+pub fn note_lines(notes: &[Note], names: &[String], clock: &Clock) -> Vec<NoteLine> {
+    let mut seen = std::collections::HashSet::new();
+    notes
+        .iter()
+        .filter(|n| seen.insert(**n))
+        .map(|n| NoteLine {
+            action: name_of(names, n.action),
+            start: clock.time_of(n.start_seq),
+            end: clock.time_of(n.end_seq),
+            words: why_words(n, names),
+        })
+        .collect()
+}
+
+/// The notes as `simulate --why` prints them: one line per [`note_lines`] line.
 pub fn write_notes(
     mut out: impl Write,
     notes: &[Note],
     names: &[String],
     clock: &Clock,
 ) -> Result<()> {
-    if notes.is_empty() {
+    let lines = note_lines(notes, names, clock);
+    if lines.is_empty() {
         writeln!(
             out,
             "why: every match committed was reported as its pattern's action"
@@ -188,15 +218,11 @@ pub fn write_notes(
         return Ok(());
     }
     writeln!(out, "why (matches dropped or read as another action):")?;
-    let mut seen = std::collections::HashSet::new();
-    for n in notes.iter().filter(|n| seen.insert(**n)) {
+    for l in lines {
         writeln!(
             out,
             "{:<12} {:>9.3} {:>9.3}  {}",
-            name_of(names, n.action),
-            clock.time_of(n.start_seq),
-            clock.time_of(n.end_seq),
-            why_words(n, names)
+            l.action, l.start, l.end, l.words
         )?;
     }
     Ok(())
