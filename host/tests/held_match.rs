@@ -6,7 +6,8 @@
 //! was never matched. Generated with the project's own generator and a library learnt from
 //! it, as `figurine eval` does (train seed 1, test seed 1000).
 
-use figurine_host::recognize::eval::{learn_synth_library, run_doodle};
+use figurine_host::recognize::eval::learn_synth_library;
+use figurine_host::recognize::scoring::run_doodle;
 use figurine_host::recognize::simulate::load_effort;
 use figurine_host::synth::{self, Knobs};
 

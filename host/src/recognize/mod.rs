@@ -7,8 +7,8 @@
 //! - [`dtw`] + [`learn`] ([`intent`], [`columns`], [`sides`]) + [`separate`]: `figurine learn`.
 //! - [`effort_train`] + [`report`] (+ `font`): `figurine train-effort`.
 //! - [`simulate`]: `figurine simulate`.
-//! - [`eval_cli`]: `figurine eval`, the accuracy tables of [`eval`] (+ [`eval_pairs`]) or a
-//!   benchmark: [`rest_bench`]: `figurine eval rest` (false
+//! - [`eval_cli`]: `figurine eval`, the accuracy tables of [`eval`] (+ [`eval_pairs`]; events
+//!   scored against labels by [`scoring`]) or a benchmark: [`rest_bench`]: `figurine eval rest` (false
 //!   alarms per hour at rest); [`sweep`]: `figurine eval sweep` (robustness to noise, rate,
 //!   scale); [`repeat_bench`]: `figurine eval repeat` (one action played several times back to
 //!   back).
@@ -32,6 +32,7 @@ pub mod regex;
 pub mod repeat_bench;
 pub mod report;
 pub mod rest_bench;
+pub mod scoring;
 pub mod separate;
 pub mod sides;
 pub mod simulate;

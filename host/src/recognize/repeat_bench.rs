@@ -15,7 +15,8 @@ use anyhow::{bail, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::eval::{learn_synth_library, pair_events, run_doodle, Ev};
+use super::eval::learn_synth_library;
+use super::scoring::{pair_events, run_doodle, Ev};
 use super::simulate::load_effort;
 use crate::synth::{self, Action, Knobs, Label, Range};
 
@@ -230,7 +231,7 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::recognize::eval::tests::{ev, label};
+    use crate::recognize::scoring::tests::{ev, label};
 
     #[test]
     fn a_bout_of_a_continuing_action_is_one_label_and_one_shot_repeats_are_each_one() {
