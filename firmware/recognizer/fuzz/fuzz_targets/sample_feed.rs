@@ -1,7 +1,8 @@
 //! Fuzzes the sample feed: arbitrary bytes become a stream of samples (any sequence numbers,
 //! times, NaN/inf/huge values, zero quaternions, time going backwards) fed to a recognizer with
-//! a small library and effort model. Invariants: no panic; every sample is accepted or counted
-//! as skipped; events have end ≥ start.
+//! a small library and effort model, with the decision stage's notes asked for or not (the
+//! first byte's low bit). Invariants: no panic; every sample is accepted or counted as skipped;
+//! events and notes have end ≥ start; a note names an action of the library.
 #![no_main]
 
 use figurine_recognizer::bayes::{AxisModel, Classifier, EffortModel, MAX_EFFORT_FEATURES};
@@ -45,6 +46,11 @@ fuzz_target!(|data: &[u8]| {
     let mut rec = Recognizer::new(lib, Some(effort()));
     let mut t = 0u64;
     let mut pushed = 0u32;
+    let noted = data.first().is_some_and(|b| b & 1 != 0);
+    let note = |n: figurine_recognizer::Note| {
+        assert!(n.end_us >= n.start_us);
+        assert!(usize::from(n.action) < 2);
+    };
     for chunk in data.chunks_exact(16) {
         let w = |i: usize| u16::from_le_bytes([chunk[i], chunk[i + 1]]);
         // Mostly plausible motion (small steps), sometimes raw bit patterns.
@@ -60,10 +66,18 @@ fuzz_target!(|data: &[u8]| {
             pos: [f(w(0)), f(w(2)), f(w(4))],
             quat: [f(w(6)) + if raw { 0.0 } else { 1.0 }, f(w(8)), f(w(10)), f(w(12))],
         };
-        rec.push(&s, |e| assert!(e.end_us >= e.start_us));
+        if noted {
+            rec.push_noted(&s, |e| assert!(e.end_us >= e.start_us), note);
+        } else {
+            rec.push(&s, |e| assert!(e.end_us >= e.start_us));
+        }
         pushed += 1;
     }
-    rec.flush(|e| assert!(e.end_us >= e.start_us));
+    if noted {
+        rec.flush_noted(|e| assert!(e.end_us >= e.start_us), note);
+    } else {
+        rec.flush(|e| assert!(e.end_us >= e.start_us));
+    }
     let st = rec.stats();
     assert_eq!(st.intake.accepted + st.intake.skipped(), pushed);
 });
