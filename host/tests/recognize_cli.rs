@@ -277,11 +277,16 @@ fn eval_over_seed_pairs_prints_each_pair_and_the_mean() {
 /// A pose log at 100 Hz: still 0.6 s, one stroke of 5 cm to the figurine's left lasting
 /// `stroke_s` (minimum-jerk-like), then still.
 fn left_stroke(path: &Path, stroke_s: f64) {
+    stroke_of(path, stroke_s, 0.05);
+}
+
+/// [`left_stroke`] of `metres` along +X (the figurine's left; negative: its right).
+fn stroke_of(path: &Path, stroke_s: f64, metres: f64) {
     let mut csv = String::from("t,x,y,z,qw,qx,qy,qz\n");
     for i in 0..((1.4 + stroke_s) * 100.0) as usize {
         let t = i as f64 / 100.0;
         let u = ((t - 0.6) / stroke_s).clamp(0.0, 1.0);
-        let x = 0.05 * (u - (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU);
+        let x = metres * (u - (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU);
         csv += &format!("{t:.4},{x:.5},1.0,0.0,1,0,0,0\n");
     }
     std::fs::write(path, csv).unwrap();
@@ -332,6 +337,21 @@ fn simulate_why_names_the_rule_that_dropped_a_match() {
         text.contains("every match committed was reported"),
         "{text}"
     );
+    // A stroke to the right is read as nothing: said so, with the tokens it moved.
+    let right = d.join("right.csv");
+    stroke_of(&right, 0.4, -0.05);
+    let text = why(&right);
+    assert!(text.contains("0 actions"), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("(none)") && l.contains("moved (`r`), but no action read it")),
+        "{text}"
+    );
+    // A figurine that never moved: nothing stood out of the noise.
+    let still = d.join("still.csv");
+    stroke_of(&still, 0.4, 0.0);
+    let text = why(&still);
+    assert!(text.contains("nothing moved"), "{text}");
     // The notes are for the table; the JSON lines stay events only.
     let out = figurine(&["simulate", "--why", "--jsonl", flick.to_str().unwrap()]);
     assert!(!out.status.success());

@@ -12,12 +12,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use figurine_recognizer::segment::{BRIEF_TURN_RAD, MIN_ACTION_US};
+use figurine_recognizer::history::Run;
+use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
+use figurine_recognizer::token::{Token, STILL};
 use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Stats, Why};
 
+use super::columns::edit_distance;
 use super::effort_model::EffortFile;
-use super::feed::{log_samples, recognize_log_noted, Clock};
-use super::library::LibraryFile;
+use super::feed::{log_runs, log_samples, recognize_log_noted, Clock};
+use super::library::{parse_tokens, tokens_to_string, LibraryFile};
 use crate::events::{write_event, ActionRecord};
 use crate::poselog::PoseLog;
 
@@ -160,12 +163,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             sim.unsendable
         )?;
         if args.why {
-            write_notes(
-                &mut out,
-                &sim.notes,
-                &lib.names(),
-                &Clock::new(&log, &log_samples(&log).0),
-            )?;
+            let mut lines = note_lines(&sim.notes, &lib.names(), &sim.clock);
+            lines.extend(unread_lines(&log, &sim, &lib)?);
+            write_note_lines(&mut out, &lines)?;
         }
     }
     out.flush()?;
@@ -202,14 +202,8 @@ pub fn note_lines(notes: &[Note], names: &[String], clock: &Clock) -> Vec<NoteLi
         .collect()
 }
 
-/// The notes as `simulate --why` prints them: one line per [`note_lines`] line.
-pub fn write_notes(
-    mut out: impl Write,
-    notes: &[Note],
-    names: &[String],
-    clock: &Clock,
-) -> Result<()> {
-    let lines = note_lines(notes, names, clock);
+/// The lines `simulate --why` prints ([`note_lines`], then [`unread_lines`]).
+pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
     if lines.is_empty() {
         writeln!(
             out,
@@ -217,7 +211,10 @@ pub fn write_notes(
         )?;
         return Ok(());
     }
-    writeln!(out, "why (matches dropped or read as another action):")?;
+    writeln!(
+        out,
+        "why (matches dropped or read as another action; motion read as nothing):"
+    )?;
     for l in lines {
         writeln!(
             out,
@@ -226,6 +223,83 @@ pub fn write_notes(
         )?;
     }
     Ok(())
+}
+
+/// Motion no event and no note of `sim` accounts for: each phrase of moving token runs
+/// (split at a stillness of `segment::CONTINUE_US`, as long as an event waits for its next
+/// piece) that was read as nothing, with the library example nearest it in tokens (by
+/// Levenshtein distance; the device's automata weigh edits more finely); or, when nothing in
+/// `log` stood out of the tracker's noise, one line that says so.
+pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Result<Vec<NoteLine>> {
+    let (samples, _) = log_samples(log);
+    let runs = log_runs(&samples);
+    let (Some(first), Some(last)) = (runs.first(), runs.last()) else {
+        return Ok(Vec::new());
+    };
+    let time = |seq: u32| sim.clock.time_of(seq);
+    if runs.iter().all(|r| r.token == STILL) {
+        return Ok(vec![NoteLine {
+            action: "(none)".into(),
+            start: time(first.start.0),
+            end: time(last.end.0),
+            words: "nothing moved: all motion stayed within the tracker's noise, which the \
+                    device learns from the stream (play bigger or faster)"
+                .into(),
+        }]);
+    }
+    let mut phrases: Vec<Vec<&Run>> = vec![Vec::new()];
+    for r in &runs {
+        let long_still = r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US;
+        match phrases.last_mut() {
+            Some(p) if long_still && !p.is_empty() => phrases.push(Vec::new()),
+            Some(p) if r.token != STILL => p.push(r),
+            _ => {}
+        }
+    }
+    let told: Vec<(u32, u32)> = sim
+        .events
+        .iter()
+        .map(|e| (e.start_seq, e.end_seq))
+        .chain(sim.notes.iter().map(|n| (n.start_seq, n.end_seq)))
+        .collect();
+    let mut examples: Vec<(&str, Vec<Token>)> = Vec::new();
+    for a in &lib.actions {
+        for e in &a.examples {
+            examples.push((&a.name, parse_tokens(e)?));
+        }
+    }
+    let mut out = Vec::new();
+    for p in &phrases {
+        let (Some(a), Some(b)) = (p.first(), p.last()) else {
+            continue;
+        };
+        let (a, b) = (a.start.0, b.end.0);
+        if told.iter().any(|&(s, e)| s <= b && a <= e) {
+            continue;
+        }
+        let tokens: Vec<Token> = p.iter().map(|r| r.token).collect();
+        let moved = tokens_to_string(&tokens);
+        let words = match examples
+            .iter()
+            .map(|(name, ex)| (edit_distance(&tokens, ex), name, ex))
+            .min_by_key(|(d, ..)| *d)
+        {
+            Some((d, name, ex)) => format!(
+                "moved (`{moved}`), but no action read it; the nearest example is `{name}`'s \
+                 `{}`, {d} edit{} away",
+                tokens_to_string(ex),
+                if d == 1 { "" } else { "s" }
+            ),
+            None => format!("moved (`{moved}`), but no action read it"),
+        };
+        out.push(NoteLine {
+            action: "(none)".into(),
+            start: time(a),
+            end: time(b),
+            words,
+        });
+    }
+    Ok(out)
 }
 
 fn name_of(names: &[String], a: u8) -> String {
