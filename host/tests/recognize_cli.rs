@@ -352,6 +352,8 @@ fn simulate_why_names_the_rule_that_dropped_a_match() {
     stroke_of(&still, 0.4, 0.0);
     let text = why(&still);
     assert!(text.contains("nothing moved"), "{text}");
+    // ... and it names the speed a stroke must pass: the 7 cm/s floor for a noiseless log.
+    assert!(text.contains("must pass 7.0 cm/s"), "{text}");
     // The notes are for the table; the JSON lines stay events only.
     let out = figurine(&["simulate", "--why", "--jsonl", flick.to_str().unwrap()]);
     assert!(!out.status.success());

@@ -143,6 +143,12 @@ pub fn log_events(
 
 /// All token runs of a log (STILL included), in order, with their feature sums.
 pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
+    log_runs_and_noise(samples).0
+}
+
+/// [`log_runs`], and the tracker's noise the front end learnt from the log by its end: rms
+/// of translation (m/s) and rotation (rad/s), as `Frontend::noise_rms` gives them.
+pub fn log_runs_and_noise(samples: &[(usize, Sample)]) -> (Vec<Run>, (f32, f32)) {
     let mut front = Frontend::new();
     let mut runs = Vec::new();
     for (_, s) in samples {
@@ -162,7 +168,7 @@ pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
         runs.push(*last);
     }
     // A gap clears the history, so consecutive duplicates cannot arise; keep order as seen.
-    runs
+    (runs, front.noise_rms())
 }
 
 /// The runs of a one-performance log's gesture, through the wire as the device sees them

@@ -13,13 +13,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use figurine_recognizer::history::Run;
+use figurine_recognizer::noise::{ON_FACTOR, V_FLOOR_M_S, W_FLOOR_RAD_S};
 use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
 use figurine_recognizer::token::{Token, STILL};
 use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Stats, Why};
 
 use super::columns::edit_distance;
 use super::effort_model::EffortFile;
-use super::feed::{log_runs, log_samples, recognize_log_noted, Clock};
+use super::feed::{log_runs_and_noise, log_samples, recognize_log_noted, Clock};
 use super::library::{parse_tokens, tokens_to_string, LibraryFile};
 use crate::events::{write_event, ActionRecord};
 use crate::poselog::PoseLog;
@@ -232,7 +233,7 @@ pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
 /// `log` stood out of the tracker's noise, one line that says so.
 pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Result<Vec<NoteLine>> {
     let (samples, _) = log_samples(log);
-    let runs = log_runs(&samples);
+    let (runs, (lin_rms, rot_rms)) = log_runs_and_noise(&samples);
     let (Some(first), Some(last)) = (runs.first(), runs.last()) else {
         return Ok(Vec::new());
     };
@@ -242,9 +243,15 @@ pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Resul
             action: "(none)".into(),
             start: time(first.start.0),
             end: time(last.end.0),
-            words: "nothing moved: all motion stayed within the tracker's noise, which the \
-                    device learns from the stream (play bigger or faster)"
-                .into(),
+            words: format!(
+                "nothing moved: a stroke must pass {:.1} cm/s or a twist {:.0}°/s — the \
+                 floors, or {ON_FACTOR} × the tracker's noise the device learnt from the \
+                 stream ({:.1} cm/s, {:.0}°/s rms); play bigger or faster",
+                100.0 * V_FLOOR_M_S.max(ON_FACTOR * lin_rms),
+                W_FLOOR_RAD_S.max(ON_FACTOR * rot_rms).to_degrees(),
+                100.0 * lin_rms,
+                rot_rms.to_degrees()
+            ),
         }]);
     }
     let mut phrases: Vec<Vec<&Run>> = vec![Vec::new()];
