@@ -4,7 +4,9 @@
 //! internal grid of [`TICK_US`] so that timestamps, not sample counts, define rates: a 30 Hz and
 //! a 240 Hz log of the same motion produce the same ticks up to interpolation error. Position is
 //! interpolated linearly, orientation by normalised lerp on the sign-aligned quaternion (q and −q
-//! are the same rotation; the sign is chosen to continue the previous sample's). Before that,
+//! are the same rotation, and the sign says which way round the figurine turned since the
+//! previous sample: the short way, unless the previous step's turn rate, carried over this
+//! step, passes the half turn — a fast spin across frames the tracker lost). Before that,
 //! each sample passes a first-order low-pass cut at the grid's Nyquist rate
 //! ([`ANTI_ALIAS_TAU_US`]), so a fast tracker's jitter is averaged rather than aliased onto
 //! the grid.
@@ -113,6 +115,10 @@ pub struct Intake {
     /// sample's sign continues this one, not the low-passed state, whose lag would turn a
     /// step near half a turn (a fast spin at 30 Hz) the other way round.
     raw_quat: [f32; 4],
+    /// The last step's turn rate, rad/s, as a rotation vector in the figurine's frame (the
+    /// step `q_prev⁻¹ q` over its time; its axis is the same before and after the step): what
+    /// carries a spin across frames the tracker lost.
+    raw_rate: [f32; 3],
     next_tick_us: u64,
 }
 
@@ -138,6 +144,7 @@ impl Intake {
             prev: None,
             cur: None,
             raw_quat: [1.0, 0.0, 0.0, 0.0],
+            raw_rate: [0.0; 3],
             next_tick_us: 0,
         }
     }
@@ -196,10 +203,7 @@ impl Intake {
             self.counters.jumps = self.counters.jumps.saturating_add(1);
             return Accept::Rejected;
         }
-        if fmath::qdot(q, self.raw_quat) < 0.0 {
-            q = [-q[0], -q[1], -q[2], -q[3]];
-        }
-        self.raw_quat = q;
+        q = self.continue_turn(q, dt_s);
         // First-order low-pass, exact for any sample spacing up to the discretisation
         // (dt / (τ + dt)): slow trackers pass nearly untouched, fast ones are averaged.
         let a = dt_us as f32 / (ANTI_ALIAS_TAU_US + dt_us) as f32;
@@ -224,12 +228,50 @@ impl Intake {
         Accept::Accepted
     }
 
+    /// `q` with the sign that says which way round the figurine turned since the last sample
+    /// (nlerp from `raw_quat` follows it), remembering the step's rate for the next one.
+    ///
+    /// The short way (≤ half a turn) unless the last step's rate, carried over `dt_s`, reaches
+    /// past the half turn the other way: of the two rotations that end at `q`, the one nearer
+    /// the rate the figurine already had. Between samples of a steady tracker the two agree;
+    /// across frames lost mid-spin (≈ 1 rad a frame at 30 Hz) the short way runs backwards.
+    fn continue_turn(&mut self, q: [f32; 4], dt_s: f32) -> [f32; 4] {
+        let mut q = q;
+        if fmath::qdot(q, self.raw_quat) < 0.0 {
+            q = [-q[0], -q[1], -q[2], -q[3]];
+        }
+        let step = fmath::qmul(fmath::qconj(self.raw_quat), q);
+        let v = [step[1], step[2], step[3]];
+        let s = fmath::norm3(v);
+        self.raw_quat = q;
+        if s <= 0.0 {
+            self.raw_rate = [0.0; 3];
+            return q;
+        }
+        let axis = [v[0] / s, v[1] / s, v[2] / s];
+        let short = 2.0 * fmath::atan2(s, step[0]);
+        // Rate of the last step along this one's axis, carried over this step (radians):
+        // below −(π − short) the rotation the long way round is the nearer one.
+        let carried = fmath::dot3(self.raw_rate, axis) * dt_s;
+        let angle = if carried < short - core::f32::consts::PI {
+            q = [-q[0], -q[1], -q[2], -q[3]];
+            self.raw_quat = q;
+            short - 2.0 * core::f32::consts::PI
+        } else {
+            short
+        };
+        let rate = angle / dt_s;
+        self.raw_rate = [axis[0] * rate, axis[1] * rate, axis[2] * rate];
+        q
+    }
+
     fn start(&mut self, s: &Sample, q: [f32; 4]) {
         self.counters.accepted = self.counters.accepted.saturating_add(1);
         self.origin = s.pos;
         self.prev = None;
         self.cur = Some((s.t_us, [0.0; 3], q, s.seq));
         self.raw_quat = q;
+        self.raw_rate = [0.0; 3];
         self.next_tick_us = s.t_us;
     }
 
@@ -441,6 +483,75 @@ mod tests {
                 w[1]
             );
         }
+    }
+
+    /// Ticks' orientations of samples turning about +Y: `(t_us, yaw in radians)` each, the
+    /// quaternion's sign flipped on every third sample, as a tracker may send it.
+    fn yaw_ticks(samples: &[(u64, f32)]) -> heapless::Vec<[f32; 4], 128> {
+        let mut i = Intake::new();
+        let mut ticks = heapless::Vec::new();
+        for (k, &(t_us, yaw)) in samples.iter().enumerate() {
+            let q = [libm::cosf(0.5 * yaw), 0.0, libm::sinf(0.5 * yaw), 0.0];
+            let quat = if (k * 7) % 3 == 1 { q.map(|c| -c) } else { q };
+            i.push(&Sample {
+                seq: k as u32,
+                t_us,
+                pos: [0.0, 1.0, 0.0],
+                quat,
+            });
+            while let Some(t) = i.next_tick() {
+                ticks.push(t.quat).unwrap();
+            }
+        }
+        ticks
+    }
+
+    /// Signed turns about +Y from each tick to the next, radians.
+    fn yaw_steps(ticks: &[[f32; 4]]) -> heapless::Vec<f32, 128> {
+        ticks
+            .windows(2)
+            .map(|w| {
+                let r = fmath::qmul(fmath::qconj(w[0]), w[1]);
+                let r = if r[0] < 0.0 { r.map(|c| -c) } else { r };
+                2.0 * libm::atan2f(r[2], r[0])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_spin_keeps_turning_across_frames_the_tracker_lost() {
+        // 1 rad a frame at 30 Hz; frames 6-9 lost, so the sample after the gap is 5 rad on —
+        // 1.28 rad back the short way.
+        let samples: heapless::Vec<(u64, f32), 16> = (0..14u64)
+            .filter(|k| !(6..10).contains(k))
+            .map(|k| (k * 33_333, k as f32))
+            .collect();
+        let steps = yaw_steps(&yaw_ticks(&samples));
+        assert!(
+            steps.iter().all(|&a| a > 0.0),
+            "a tick turned back: {steps:?}"
+        );
+        let total: f32 = steps.iter().sum();
+        // The low-pass trails the last sample by a few hundredths of a radian.
+        assert!((total - 13.0).abs() < 0.2, "turned {total} rad of 13");
+    }
+
+    #[test]
+    fn after_a_gap_at_rest_the_short_way_round_stands() {
+        // Still, then seen again 0.2 s later 160° round: nothing said it spun the long way.
+        let steps = yaw_steps(&yaw_ticks(&[
+            (0, 0.0),
+            (33_333, 0.0),
+            (66_666, 0.0),
+            (266_666, -160f32.to_radians()),
+        ]));
+        assert!(
+            steps.iter().all(|&a| a <= 0.0),
+            "a tick turned on: {steps:?}"
+        );
+        // Ticks stop at the last one before the sample (6.7 ms short of it).
+        let total: f32 = steps.iter().sum();
+        assert!((-2.8..-2.6).contains(&total), "turned {total} rad");
     }
 
     #[test]
