@@ -359,6 +359,41 @@ fn simulate_why_names_the_rule_that_dropped_a_match() {
     assert!(!out.status.success());
 }
 
+/// `simulate --why` names each stretch the tracker gave no sample for, with how far the
+/// figurine turned across it either way round, and says when the recognizer started afresh.
+#[test]
+fn simulate_why_names_the_samples_the_tracker_lost() {
+    let d = tmp("lost");
+    // 30 Hz, still 1 s, then turning 0.5 rad a frame about +Y; frames 36-39 lost (0.17 s),
+    // across which it turns 2.5 rad (143°); then a 0.4 s gap at rest.
+    let mut csv = String::from("t,x,y,z,qw,qx,qy,qz\n");
+    for k in 0..90u32 {
+        if (36..40).contains(&k) || (70..82).contains(&k) {
+            continue;
+        }
+        let yaw = 0.5 * f64::from(k.clamp(30, 50) - 30);
+        let t = f64::from(k) / 30.0;
+        csv += &format!(
+            "{t:.4},0,1,0,{:.6},0,{:.6},0\n",
+            (yaw / 2.0).cos(),
+            (yaw / 2.0).sin()
+        );
+    }
+    let log = d.join("lost.csv");
+    std::fs::write(&log, csv).unwrap();
+    let out = figurine(&["simulate", "--why", log.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lost: Vec<&str> = text.lines().filter(|l| l.starts_with("(lost)")).collect();
+    assert_eq!(lost.len(), 2, "{text}");
+    assert!(
+        lost[0].contains("no sample for 0.17 s (4 of its 30 Hz samples)")
+            && lost[0].contains("turned 143° (or 217° the other way round)"),
+        "{text}"
+    );
+    assert!(lost[1].contains("starts afresh"), "{text}");
+}
+
 /// `eval --verbose` names every misread gesture with the command that plays it again — under
 /// the evaluation's own tracker — and says why the decision stage dropped what it dropped.
 #[test]

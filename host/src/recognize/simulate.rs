@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use figurine_recognizer::history::Run;
+use figurine_recognizer::intake::MAX_GAP_US;
 use figurine_recognizer::noise::{ON_FACTOR, V_FLOOR_M_S, W_FLOOR_RAD_S};
 use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
 use figurine_recognizer::token::{Token, STILL};
@@ -166,6 +167,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         if args.why {
             let mut lines = note_lines(&sim.notes, &lib.names(), &sim.clock);
             lines.extend(unread_lines(&log, &sim, &lib)?);
+            lines.extend(lost_lines(&log));
             write_note_lines(&mut out, &lines)?;
         }
     }
@@ -203,7 +205,7 @@ pub fn note_lines(notes: &[Note], names: &[String], clock: &Clock) -> Vec<NoteLi
         .collect()
 }
 
-/// The lines `simulate --why` prints ([`note_lines`], then [`unread_lines`]).
+/// The lines `simulate --why` prints ([`note_lines`], [`unread_lines`], [`lost_lines`]).
 pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
     if lines.is_empty() {
         writeln!(
@@ -214,7 +216,7 @@ pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
     }
     writeln!(
         out,
-        "why (matches dropped or read as another action; motion read as nothing):"
+        "why (matches dropped or read as another action; motion read as nothing; samples lost):"
     )?;
     for l in lines {
         writeln!(
@@ -308,6 +310,76 @@ pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Resul
     }
     Ok(out)
 }
+
+/// Stretches where the tracker gave no sample for at least [`LOST_INTERVALS`] of its usual
+/// intervals (the median), with how far the figurine turned (the short way) and moved across
+/// each: the recognizer only guesses what happened there from both ends, and after a stretch
+/// longer than `intake::MAX_GAP_US` it starts afresh.
+pub fn lost_lines(log: &PoseLog) -> Vec<NoteLine> {
+    let (samples, _) = log_samples(log);
+    let mut steps: Vec<u64> = samples
+        .windows(2)
+        .map(|w| w[1].1.t_us.saturating_sub(w[0].1.t_us))
+        .filter(|&d| d > 0)
+        .collect();
+    steps.sort_unstable();
+    let Some(&usual) = steps.get(steps.len() / 2) else {
+        return Vec::new();
+    };
+    let time = |i: usize| log.samples.get(i).map_or(0.0, |s| s.t);
+    samples
+        .windows(2)
+        .filter_map(|w| {
+            let ((i, a), (j, b)) = (w[0], w[1]);
+            let dt = b.t_us.saturating_sub(a.t_us);
+            if dt < LOST_INTERVALS * usual.max(1) {
+                return None;
+            }
+            let dot: f32 = a.quat.iter().zip(b.quat).map(|(x, y)| x * y).sum();
+            let norms = (a.quat.iter().map(|x| x * x).sum::<f32>()
+                * b.quat.iter().map(|x| x * x).sum::<f32>())
+            .sqrt();
+            let turned = (2.0 * (dot.abs() / norms).min(1.0).acos()).to_degrees();
+            let moved: f32 = a
+                .pos
+                .iter()
+                .zip(b.pos)
+                .map(|(x, y)| (y - x) * (y - x))
+                .sum::<f32>()
+                .sqrt();
+            let words = if dt > MAX_GAP_US {
+                format!(
+                    "the tracker gave no sample for {:.2} s: the recognizer starts afresh \
+                     after it, and a gesture across it is not read whole",
+                    dt as f64 * 1e-6
+                )
+            } else {
+                format!(
+                    "the tracker gave no sample for {:.2} s ({} of its {:.0} Hz samples); \
+                     across it the figurine turned {turned:.0}° (or {:.0}° the other way \
+                     round) and moved {:.1} cm: the recognizer bridges it from both ends, \
+                     the long way round only when the turn before it was heading there \
+                     that fast",
+                    dt as f64 * 1e-6,
+                    dt / usual.max(1) - 1,
+                    1e6 / usual as f64,
+                    360.0 - turned,
+                    100.0 * moved,
+                )
+            };
+            Some(NoteLine {
+                action: "(lost)".into(),
+                start: time(i),
+                end: time(j),
+                words,
+            })
+        })
+        .collect()
+}
+
+/// Missing samples, in the tracker's usual intervals, that [`lost_lines`] names: two or more
+/// in a row (one lost now and then is common and harmless).
+pub const LOST_INTERVALS: u64 = 3;
 
 fn name_of(names: &[String], a: u8) -> String {
     names
