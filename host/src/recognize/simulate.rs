@@ -168,6 +168,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             let mut lines = note_lines(&sim.notes, &lib.names(), &sim.clock);
             lines.extend(unread_lines(&log, &sim, &lib)?);
             lines.extend(lost_lines(&log));
+            lines.sort_by(|a, b| a.start.total_cmp(&b.start));
             write_note_lines(&mut out, &lines)?;
         }
     }
@@ -205,7 +206,8 @@ pub fn note_lines(notes: &[Note], names: &[String], clock: &Clock) -> Vec<NoteLi
         .collect()
 }
 
-/// The lines `simulate --why` prints ([`note_lines`], [`unread_lines`], [`lost_lines`]).
+/// The lines `simulate --why` prints ([`note_lines`], [`unread_lines`], [`lost_lines`]; it
+/// sorts them by start first).
 pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
     if lines.is_empty() {
         writeln!(
