@@ -17,7 +17,9 @@ use figurine_recognizer::intake::MAX_GAP_US;
 use figurine_recognizer::noise::{ON_FACTOR, V_FLOOR_M_S, W_FLOOR_RAD_S};
 use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
 use figurine_recognizer::token::{Token, STILL};
-use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Stats, Why};
+use figurine_recognizer::{
+    ActionEvent, EffortModel, Library, Note, Recognizer, Sample, Stats, Why,
+};
 
 use super::columns::edit_distance;
 use super::effort_model::EffortFile;
@@ -62,6 +64,8 @@ pub struct Simulation {
     pub stats: Stats,
     /// Log samples the wire could not carry.
     pub unsendable: u64,
+    /// The samples as the device received them, each with its index in the log.
+    pub samples: Vec<(usize, Sample)>,
 }
 
 /// Loads the library (or the default) and its device blob.
@@ -114,6 +118,7 @@ pub fn simulate_log(
         clock,
         stats: rec.stats(),
         unsendable,
+        samples,
     })
 }
 
@@ -166,8 +171,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         )?;
         if args.why {
             let mut lines = note_lines(&sim.notes, &lib.names(), &sim.clock);
-            lines.extend(unread_lines(&log, &sim, &lib)?);
-            lines.extend(lost_lines(&log));
+            lines.extend(unread_lines(&sim, &lib)?);
+            lines.extend(lost_lines(&log, &sim));
             lines.sort_by(|a, b| a.start.total_cmp(&b.start));
             write_note_lines(&mut out, &lines)?;
         }
@@ -234,10 +239,9 @@ pub fn write_note_lines(mut out: impl Write, lines: &[NoteLine]) -> Result<()> {
 /// (split at a stillness of `segment::CONTINUE_US`, as long as an event waits for its next
 /// piece) that was read as nothing, with the library example nearest it in tokens (by
 /// Levenshtein distance; the device's automata weigh edits more finely); or, when nothing in
-/// `log` stood out of the tracker's noise, one line that says so.
-pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Result<Vec<NoteLine>> {
-    let (samples, _) = log_samples(log);
-    let (runs, (lin_rms, rot_rms)) = log_runs_and_noise(&samples);
+/// the log stood out of the tracker's noise, one line that says so.
+pub fn unread_lines(sim: &Simulation, lib: &LibraryFile) -> Result<Vec<NoteLine>> {
+    let (runs, (lin_rms, rot_rms)) = log_runs_and_noise(&sim.samples);
     let (Some(first), Some(last)) = (runs.first(), runs.last()) else {
         return Ok(Vec::new());
     };
@@ -317,8 +321,8 @@ pub fn unread_lines(log: &PoseLog, sim: &Simulation, lib: &LibraryFile) -> Resul
 /// intervals (the median), with how far the figurine turned (the short way) and moved across
 /// each: the recognizer only guesses what happened there from both ends, and after a stretch
 /// longer than `intake::MAX_GAP_US` it starts afresh.
-pub fn lost_lines(log: &PoseLog) -> Vec<NoteLine> {
-    let (samples, _) = log_samples(log);
+pub fn lost_lines(log: &PoseLog, sim: &Simulation) -> Vec<NoteLine> {
+    let samples = &sim.samples;
     let mut steps: Vec<u64> = samples
         .windows(2)
         .map(|w| w[1].1.t_us.saturating_sub(w[0].1.t_us))
