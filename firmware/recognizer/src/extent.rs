@@ -17,11 +17,17 @@
 //! | [`Extent::moved_m`] | farthest world displacement from where the phrase began | m |
 //! | [`Extent::turned_rad`] | farthest rotation from where it began (\|Σ ω·dt\| about the object's axes) | rad |
 //! | [`Extent::travel_m`] | how far from where it began it ended, across the floor | m |
+//! | [`Extent::travel_share`] | learnt: the least share of its own reach that an example ended away | 0–1 |
 //! | carries | a dimension whose least extent, rotation weighed by [`ARM_M`], is at least [`CARRY_SHARE`] of the other's | — |
 //!
 //! An action whose every example travelled — a jump lands ahead of where it took off, a walk
 //! ends elsewhere — is held to its travel too, as to a dimension that carries it: a toy lifted
-//! and set back down where it was goes up and down as a jump does, but goes nowhere.
+//! and set back down where it was goes up and down as a jump does, but goes nowhere. And an
+//! action whose every example ended at least a quarter of its own reach away (its learnt
+//! travel share) must end half that share of its reach away, give or take a fidget: the
+//! share does not depend on the gesture's size, so a lift that comes down a few centimetres
+//! off the spot is still no jump, even for a library whose least jump landed only that far
+//! ahead (a drifting tracker's).
 //!
 //! The farthest point, not the path: tracker noise lengthens a path without end, but moves
 //! the figurine only as far as the noise's own size. It is read at the ends of token runs,
@@ -78,6 +84,10 @@ pub struct Extent {
     pub turned_rad: f32,
     /// Horizontal distance from the start to the end, m.
     pub travel_m: f32,
+    /// Of a learnt extent, the least share of how far an example went that it travelled
+    /// ([`Extent::travel_m`] over [`Extent::moved_m`], each example's own), 0–1; 0 when not
+    /// learnt, and in a span's extent (where the two fields say it).
+    pub travel_share: f32,
 }
 
 /// Running sums over consecutive runs ([`Accum::moved`], [`Accum::turned`]) and the farthest
@@ -99,6 +109,7 @@ impl ExtentSums {
                 moved_m: 0.0,
                 turned_rad: 0.0,
                 travel_m: 0.0,
+                travel_share: 0.0,
             },
         }
     }
@@ -140,6 +151,7 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
         moved_m: NOISE_REACH_S * rms.0,
         turned_rad: NOISE_REACH_S * rms.1,
         travel_m: 0.0,
+        travel_share: 0.0,
     }
 }
 
@@ -147,7 +159,8 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
 /// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
 /// in a dimension that carries the action, and as far across the floor when moving carries
 /// it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved, and
-/// farther than a fidget). A fidget seen through a tracker's `noise` ([`noise_reach`])
+/// farther than a fidget), and ends half the share of its own reach away that each of its
+/// examples did ([`Extent::travel_share`]). A fidget seen through a tracker's `noise` ([`noise_reach`])
 /// reaches as far as the two together (in quadrature: they are independent).
 pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     let moved = least.moved_m;
@@ -171,7 +184,17 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     } else {
         0.0
     };
+    // And at least half the share of its reach that each of its examples ended away, when
+    // that share is a real part of the action (a quarter or more; a punch's or a crouch's is
+    // the drift of the hand): a jump that went 20 cm lands 5 cm or more ahead when its
+    // examples landed half their reach ahead, where a toy lifted 20 cm comes down within a
+    // fidget of where it rose.
+    let slack = fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]);
+    let ends_away = moved < CARRY_SHARE * turned
+        || least.travel_share < CARRY_SHARE * CARRY_SHARE
+        || went.travel_m + slack >= CARRY_SHARE * least.travel_share * went.moved_m;
     went.travel_m >= need_travel
+        && ends_away
         && ((moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
             || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned))
 }
@@ -202,6 +225,7 @@ mod tests {
         moved_m: 0.0,
         turned_rad: 0.0,
         travel_m: 0.0,
+        travel_share: 0.0,
     };
 
     fn ext(moved_m: f32, turned_rad: f32) -> Extent {
@@ -209,6 +233,7 @@ mod tests {
             moved_m,
             turned_rad,
             travel_m: 0.0,
+            travel_share: 0.0,
         }
     }
 
@@ -349,6 +374,52 @@ mod tests {
         // Nor does a turn's, carried by its rotation, though the grip swung it 5 cm aside.
         let turn = Extent {
             travel_m: 0.05,
+            ..ext(0.05, 1.6)
+        };
+        assert!(far_enough(ext(0.0, 1.0), turn, QUIET));
+    }
+
+    #[test]
+    fn an_action_whose_examples_ended_away_ends_away_by_a_share_of_its_reach() {
+        // A tabletop player's jumps: the least went 5 cm and landed 2.5 cm ahead, and each
+        // landed at least 0.6 of its reach ahead.
+        let jump = Extent {
+            travel_m: 0.025,
+            travel_share: 0.6,
+            ..ext(0.05, 0.1)
+        };
+        // A toy lifted 20 cm and set down 1.5 cm off: past the jump's least travel, but not
+        // 0.3 of its own reach, even with a fidget's centimetre besides.
+        let lift = Extent {
+            travel_m: 0.015,
+            ..ext(0.2, 0.1)
+        };
+        assert!(!far_enough(lift, jump, QUIET));
+        assert!(far_enough(
+            lift,
+            Extent {
+                travel_share: 0.0,
+                ..jump
+            },
+            QUIET
+        ));
+        // A jump 6 cm high that landed 3 cm ahead is one.
+        let hop = Extent {
+            travel_m: 0.03,
+            ..ext(0.06, 0.1)
+        };
+        assert!(far_enough(hop, jump, QUIET));
+        // Examples that came back near where they began (a punch, a share of 0.1) ask for no
+        // share; nor do those of an action its rotation carries (a turn's grip swings aside).
+        let punch = Extent {
+            travel_m: 0.01,
+            travel_share: 0.1,
+            ..ext(0.2, 0.1)
+        };
+        assert!(far_enough(lift, punch, QUIET));
+        let turn = Extent {
+            travel_m: 0.05,
+            travel_share: 0.9,
             ..ext(0.05, 1.6)
         };
         assert!(far_enough(ext(0.0, 1.0), turn, QUIET));

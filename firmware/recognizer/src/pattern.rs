@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (8; version 7, whose shape table has only the first 16
-//!         bytes of each entry, is still read and its travels are not known; version 6, with
+//! 0   4   magic "FGL" + version byte (9; version 8, whose shape table has only the first 17
+//!         bytes of each entry, is still read and its travel shares are not known; version 7,
+//!         with only 16, is still read and its travels are not known either; version 6, with
 //!         only 15, is still read and its holds are not known either; version 5, with
 //!         only 13, is still read and its extents are not known either; versions 4, 3 and
 //!         2, with only 7, 6 and 4 bytes, and version 1, without the table, are still read —
@@ -28,7 +29,7 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 17 bytes per action in record order (the mean of its examples'
+//! then the shape table, 18 bytes per action in record order (the mean of its examples'
 //! shapes, `features::Shape`, how far they lay from it, how far the least of them went and
 //! how long they held still inside):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
@@ -49,6 +50,8 @@
 //!         [`HOLD_UNIT_US`]; 0 = none or not known
 //! +16 1   the least travel among the examples (how far across the floor from where each
 //!         began it ended), code in `extent::MOVED_CODE_UNIT_M`; 0 = not known
+//! +17 1   the least share of how far an example went that it travelled (its travel over its
+//!         farthest displacement), × 255 rounded; 0 = none or not known
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -66,9 +69,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 8;
+pub const LIBRARY_VERSION: u8 = 9;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 17;
+pub const SHAPE_BYTES: usize = 18;
+/// Bytes per action in a version 8 shape table (no travel share).
+const SHAPE_BYTES_V8: usize = 17;
+/// Offset of the travel share in a shape-table entry.
+const SHAPE_TRAVEL_SHARE_AT: usize = 17;
 /// Bytes per action in a version 7 shape table (no travel).
 const SHAPE_BYTES_V7: usize = 16;
 /// Offset of the travel in a shape-table entry.
@@ -99,7 +106,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,200).
+/// Largest valid library blob, bytes (12,232).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -313,6 +320,7 @@ impl<'a> Library<'a> {
             5 => SHAPE_BYTES_V5,
             6 => SHAPE_BYTES_V6,
             7 => SHAPE_BYTES_V7,
+            8 => SHAPE_BYTES_V8,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -385,26 +393,27 @@ impl<'a> Library<'a> {
 
     /// How far the least of action `i`'s examples went ([`crate::extent`]); None when not
     /// learnt (a version 5 library, or an action learnt without examples). Its travel is 0
-    /// when not known (a version 7 library).
+    /// when not known (a version 7 library), and so is its travel share (before version 9).
     pub fn extent(&self, i: usize) -> Option<Extent> {
         if self.shapes == 0 || i >= self.n || usize::from(self.stride) < SHAPE_BYTES_V6 {
             return None;
         }
         let entry = usize::from(self.shapes) + usize::from(self.stride) * i;
         let at = entry + SHAPE_EXTENT_AT;
-        let travel = if usize::from(self.stride) > SHAPE_TRAVEL_AT {
-            self.bytes
-                .get(entry + SHAPE_TRAVEL_AT)
-                .copied()
-                .unwrap_or(0)
-        } else {
-            0
+        let byte = |at: usize| {
+            if usize::from(self.stride) > at {
+                self.bytes.get(entry + at).copied().unwrap_or(0)
+            } else {
+                0
+            }
         };
+        let travel = byte(SHAPE_TRAVEL_AT);
         match *self.bytes.get(at..at + 2)? {
             [m, t] => Some(Extent {
                 moved_m: from_byte(m, MOVED_CODE_UNIT_M)?,
                 turned_rad: from_byte(t, TURNED_CODE_UNIT_RAD)?,
                 travel_m: from_byte(travel, MOVED_CODE_UNIT_M).unwrap_or(0.0),
+                travel_share: f32::from(byte(SHAPE_TRAVEL_SHARE_AT)) / 255.0,
             }),
             _ => None,
         }
@@ -620,7 +629,7 @@ pub(crate) mod tests {
                 Some([l, u, f, t, st, h]) => {
                     out.extend([*l, *u, *f, 1, *t, *st, *h]);
                     out.extend([0; SHAPE_DIMS]);
-                    out.extend([0; 4]);
+                    out.extend([0; SHAPE_BYTES - 7 - SHAPE_DIMS]);
                 }
                 None => out.extend([0; SHAPE_BYTES]),
             }
@@ -641,6 +650,7 @@ pub(crate) mod tests {
             out.extend([
                 to_byte(m, MOVED_CODE_UNIT_M),
                 to_byte(t, TURNED_CODE_UNIT_RAD),
+                0,
                 0,
                 0,
             ]);
@@ -778,6 +788,21 @@ pub(crate) mod tests {
         let e = lib_extent(&ext).unwrap();
         assert!((e.travel_m - 0.0512).abs() < 1e-5, "{e:?}");
         assert_eq!(Library::from_bytes(&ext).unwrap().hold_us(0), 920_000);
+        // The travel share, in 255ths; not known (0) in a version 8 library, whose entries end
+        // at the travel.
+        assert_eq!(e.travel_share, 0.0);
+        ext[entry + SHAPE_TRAVEL_SHARE_AT] = 153;
+        let e = lib_extent(&ext).unwrap();
+        assert!((e.travel_share - 0.6).abs() < 1e-6, "{e:?}");
+        let mut v8 = v1.clone();
+        v8[3] = 8;
+        v8.extend(&ext[entry..entry + SHAPE_BYTES_V8]);
+        v8.extend([0; SHAPE_BYTES_V8]);
+        let e = lib_extent(&v8).unwrap();
+        assert!(
+            (e.travel_m - 0.0512).abs() < 1e-5 && e.travel_share == 0.0,
+            "{e:?}"
+        );
         // The extents, both known or neither.
         assert_eq!(lib_extent(&tol), None);
         let mut ext = tol.clone();
@@ -832,8 +857,11 @@ pub(crate) mod tests {
             }
         }
         let mut b = blob.clone();
-        b[3] = 9;
-        assert_eq!(Library::from_bytes(&b).unwrap_err(), Error::Version(9));
+        b[3] = LIBRARY_VERSION + 1;
+        assert_eq!(
+            Library::from_bytes(&b).unwrap_err(),
+            Error::Version(LIBRARY_VERSION + 1)
+        );
         let too_many_edits = seq_library(&[(&["u", "d"], 2)]);
         assert!(Library::from_bytes(&too_many_edits).is_err());
     }

@@ -128,18 +128,29 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
         .reduce(f32::max)
 }
 
-/// The least extent among gestures that moved, dimension by dimension: how far the least of
-/// an action's examples went, what the device holds a performance to
+/// The least extent among gestures that moved, dimension by dimension (and the least share of
+/// its own reach that one travelled): how far the least of an action's examples went, what the device holds a performance to
 /// ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
 pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
     gestures
         .into_iter()
         .filter(|g| !g.is_empty())
-        .map(extent_of_runs)
+        .map(|g| {
+            let e = extent_of_runs(g);
+            Extent {
+                travel_share: if e.moved_m > 0.0 {
+                    (e.travel_m / e.moved_m).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+                ..e
+            }
+        })
         .reduce(|a, b| Extent {
             moved_m: a.moved_m.min(b.moved_m),
             turned_rad: a.turned_rad.min(b.turned_rad),
             travel_m: a.travel_m.min(b.travel_m),
+            travel_share: a.travel_share.min(b.travel_share),
         })
 }
 
@@ -378,6 +389,28 @@ mod tests {
             }
         }
         assert!(read >= 22, "only {read} of 24 examples moved");
+    }
+
+    #[test]
+    fn a_jump_lands_a_share_of_its_reach_ahead_where_a_punch_comes_back() {
+        // The least share of its own reach that an example ended away across the floor: what
+        // tells a jump from a toy lifted and set down where it rose, whatever the size.
+        let share = |action: Action, seed: u64| {
+            learn_action("a", &example_logs(action, seed), None, false)
+                .unwrap()
+                .travel_share
+                .unwrap()
+        };
+        for seed in [1, 2, 3] {
+            let (walk, jump, punch, crouch) = (
+                share(Action::Walk, seed),
+                share(Action::Jump, seed),
+                share(Action::Punch, seed),
+                share(Action::Crouch, seed),
+            );
+            assert!(walk > 0.9 && jump > 0.3, "walk {walk} jump {jump}");
+            assert!(punch < 0.2 && crouch < 0.2, "punch {punch} crouch {crouch}");
+        }
     }
 
     #[test]

@@ -82,6 +82,13 @@ pub struct ActionEntry {
     /// pattern written by hand or learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub travel_m: Option<f32>,
+    /// The least share of how far an example went that it ended away across the floor (its
+    /// travel over its farthest displacement), 0–1: a performance of an action that moving
+    /// carries must end at least half that share of its own reach away (a toy lifted and set
+    /// down where it rose is no jump); absent for a pattern written by hand or learnt before
+    /// it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub travel_share: Option<f32>,
     /// The longest stillness inside any example, between its first and last motion, s: how
     /// long a performance may hold and go on (a crouch held low, then risen from). The device
     /// keeps the event open for a continuation that long; absent when no example held, for a
@@ -175,6 +182,7 @@ impl ActionEntry {
             shape_spread: None,
             extent: None,
             travel_m: None,
+            travel_share: None,
             hold_s: None,
         };
         let c = Regex::parse(regex)?.compile()?;
@@ -220,6 +228,7 @@ impl ActionEntry {
     pub fn with_extent(mut self, extent: Option<Extent>) -> Self {
         self.extent = extent.map(|e| [e.moved_m, e.turned_rad]);
         self.travel_m = extent.map(|e| e.travel_m);
+        self.travel_share = extent.map(|e| e.travel_share);
         self
     }
 
@@ -263,6 +272,9 @@ impl ActionEntry {
                     self.travel_m
                         .filter(|t| t.is_finite() && extent.is_some())
                         .map_or(0, |t| to_byte(t, MOVED_CODE_UNIT_M)),
+                    self.travel_share
+                        .filter(|t| t.is_finite() && extent.is_some())
+                        .map_or(0, q),
                 ]
             }
             _ => [0; SHAPE_BYTES],
