@@ -110,8 +110,9 @@ fn the_command_line_writes_handling_that_reads_as_nothing() {
 /// Under a tracker that drifts (noise ×3), a player's three jumps may land only a little
 /// ahead of where they took off, less than half as far as they went (library seed 23: the
 /// least landed 7 cm ahead, the least went 15 cm), so the jump is not held to its least
-/// travel — but each landed at least 0.46 of its own reach ahead, and a performance must land
-/// half that share of its reach ahead: a toy lifted and set down is no jump.
+/// travel — but each landed at least 0.46 of its own reach ahead: a jump goes somewhere, and a
+/// performance must too (`extent::AWAY_SHARE` of its reach): a toy lifted and set down is no
+/// jump.
 #[test]
 fn a_lift_is_no_jump_for_a_library_learnt_under_a_drifting_tracker() {
     use figurine_host::recognize::eval::learn_synth_library;
@@ -144,7 +145,7 @@ fn a_lift_is_no_jump_for_a_library_learnt_under_a_drifting_tracker() {
             jumps.push(seed);
         }
     }
-    // Before, 17 of these 20 were jumps. Four still are: small lifts, whose 1–2 cm off the
-    // spot they rose from is within a fidget's centimetre of half the share.
-    assert!(jumps.len() as u64 <= LIFTS / 4, "{jumps:?}");
+    // Before, 17 of these 20 were jumps; one still is (a small lift, whose 1–2 cm off the
+    // spot it rose from is within a fidget's centimetre of a quarter of its reach).
+    assert!(jumps.len() as u64 <= LIFTS / 10, "{jumps:?}");
 }

@@ -23,11 +23,11 @@
 //! An action whose every example travelled — a jump lands ahead of where it took off, a walk
 //! ends elsewhere — is held to its travel too, as to a dimension that carries it: a toy lifted
 //! and set back down where it was goes up and down as a jump does, but goes nowhere. And an
-//! action whose every example ended at least a quarter of its own reach away (its learnt
-//! travel share) must end half that share of its reach away, give or take a fidget: the
-//! share does not depend on the gesture's size, so a lift that comes down a few centimetres
-//! off the spot is still no jump, even for a library whose least jump landed only that far
-//! ahead (a drifting tracker's).
+//! action whose every example went somewhere — ended [`AWAY_SHARE`] of its own reach away or
+//! more (its learnt travel share) — is reported only for motion that went somewhere too, give
+//! or take a fidget: a share does not depend on the gesture's size, so a lift that comes down
+//! a few centimetres off the spot is still no jump, even for a library whose least jump landed
+//! only that far ahead (a drifting tracker's).
 //!
 //! The farthest point, not the path: tracker noise lengthens a path without end, but moves
 //! the figurine only as far as the noise's own size. It is read at the ends of token runs,
@@ -64,6 +64,11 @@ pub const FIDGET_TURNED_RAD: f32 = 0.10;
 /// puts two such readings √2·σ apart with σ ≈ 0.026 s × σᵥ at 100–1000 Hz (0.036 s at
 /// 30 Hz); the farthest of a few readings lies about 1.5–2 times that.
 pub const NOISE_REACH_S: f32 = 0.05;
+/// Least share of its own reach (farthest displacement) a gesture ends away across the floor
+/// to have gone somewhere, an action's every example and each performance of it alike. The
+/// project's generator at noise ×3: a jump's examples 0.29–1.0 (60 of them), a lift set back
+/// down 0.01–0.23 (20), a punch's or a crouch's least example under 0.2.
+pub const AWAY_SHARE: f32 = 0.25;
 /// Share of the other dimension's least extent (rotation × [`ARM_M`]) a dimension must reach
 /// to carry an action: a punch barely turns and a turn barely moves; a kick and a throw carry
 /// both.
@@ -159,7 +164,7 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
 /// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
 /// in a dimension that carries the action, and as far across the floor when moving carries
 /// it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved, and
-/// farther than a fidget), and ends half the share of its own reach away that each of its
+/// farther than a fidget), and ends [`AWAY_SHARE`] of its own reach away when each of its
 /// examples did ([`Extent::travel_share`]). A fidget seen through a tracker's `noise` ([`noise_reach`])
 /// reaches as far as the two together (in quadrature: they are independent).
 pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
@@ -184,15 +189,12 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     } else {
         0.0
     };
-    // And at least half the share of its reach that each of its examples ended away, when
-    // that share is a real part of the action (a quarter or more; a punch's or a crouch's is
-    // the drift of the hand): a jump that went 20 cm lands 5 cm or more ahead when its
-    // examples landed half their reach ahead, where a toy lifted 20 cm comes down within a
-    // fidget of where it rose.
+    // And it went somewhere when each of its examples did: a jump that went 20 cm lands 5 cm
+    // or more ahead, where a toy lifted 20 cm comes down within a fidget of where it rose.
     let slack = fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]);
     let ends_away = moved < CARRY_SHARE * turned
-        || least.travel_share < CARRY_SHARE * CARRY_SHARE
-        || went.travel_m + slack >= CARRY_SHARE * least.travel_share * went.moved_m;
+        || least.travel_share < AWAY_SHARE
+        || went.travel_m + slack >= AWAY_SHARE * went.moved_m;
     went.travel_m >= need_travel
         && ends_away
         && ((moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
@@ -380,7 +382,7 @@ mod tests {
     }
 
     #[test]
-    fn an_action_whose_examples_ended_away_ends_away_by_a_share_of_its_reach() {
+    fn an_action_whose_examples_went_somewhere_must_go_somewhere() {
         // A tabletop player's jumps: the least went 5 cm and landed 2.5 cm ahead, and each
         // landed at least 0.6 of its reach ahead.
         let jump = Extent {
@@ -388,8 +390,8 @@ mod tests {
             travel_share: 0.6,
             ..ext(0.05, 0.1)
         };
-        // A toy lifted 20 cm and set down 1.5 cm off: past the jump's least travel, but not
-        // 0.3 of its own reach, even with a fidget's centimetre besides.
+        // A toy lifted 20 cm and set down 1.5 cm off: past the jump's least travel, but not a
+        // quarter of its own reach, even with a fidget's centimetre besides.
         let lift = Extent {
             travel_m: 0.015,
             ..ext(0.2, 0.1)
@@ -403,12 +405,22 @@ mod tests {
             },
             QUIET
         ));
-        // A jump 6 cm high that landed 3 cm ahead is one.
+        // A jump 6 cm high that landed 3 cm ahead is one; so is a high one, 40 cm up and
+        // 17 cm ahead (0.43 of its reach, where each example landed most of its reach ahead).
         let hop = Extent {
             travel_m: 0.03,
             ..ext(0.06, 0.1)
         };
         assert!(far_enough(hop, jump, QUIET));
+        let high = Extent {
+            travel_m: 0.17,
+            ..ext(0.4, 0.1)
+        };
+        let long = Extent {
+            travel_share: 0.95,
+            ..jump
+        };
+        assert!(far_enough(high, long, QUIET));
         // Examples that came back near where they began (a punch, a share of 0.1) ask for no
         // share; nor do those of an action its rotation carries (a turn's grip swings aside).
         let punch = Extent {

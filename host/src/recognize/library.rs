@@ -83,10 +83,10 @@ pub struct ActionEntry {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub travel_m: Option<f32>,
     /// The least share of how far an example went that it ended away across the floor (its
-    /// travel over its farthest displacement), 0–1: a performance of an action that moving
-    /// carries must end at least half that share of its own reach away (a toy lifted and set
-    /// down where it rose is no jump); absent for a pattern written by hand or learnt before
-    /// it was measured.
+    /// travel over its farthest displacement), 0–1: when every example went somewhere (a
+    /// quarter or more, `figurine_recognizer::extent::AWAY_SHARE`), so must a performance of
+    /// an action that moving carries (a toy lifted and set down where it rose is no jump);
+    /// absent for a pattern written by hand or learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub travel_share: Option<f32>,
     /// The longest stillness inside any example, between its first and last motion, s: how
