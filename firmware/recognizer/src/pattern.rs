@@ -788,8 +788,8 @@ pub(crate) mod tests {
         let e = lib_extent(&ext).unwrap();
         assert!((e.travel_m - 0.0512).abs() < 1e-5, "{e:?}");
         assert_eq!(Library::from_bytes(&ext).unwrap().hold_us(0), 920_000);
-        // The travel share, in 255ths; not known (0) in a version 8 library, whose entries end
-        // at the travel.
+        // The travel share, in 255ths (0: not known, as in a version 8 library, whose entries
+        // end at the travel).
         assert_eq!(e.travel_share, 0.0);
         ext[entry + SHAPE_TRAVEL_SHARE_AT] = 153;
         let e = lib_extent(&ext).unwrap();
