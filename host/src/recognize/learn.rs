@@ -129,8 +129,9 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
 }
 
 /// The least extent among gestures that moved, dimension by dimension (and the least share of
-/// its own reach that one travelled): how far the least of an action's examples went, what the device holds a performance to
-/// ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
+/// its own reach that one travelled): how far the least of an action's examples went, what
+/// the device holds a performance to ([`figurine_recognizer::extent::far_enough`]). None
+/// without a gesture.
 pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
     gestures
         .into_iter()
