@@ -66,8 +66,10 @@ pub const FIDGET_TURNED_RAD: f32 = 0.10;
 pub const NOISE_REACH_S: f32 = 0.05;
 /// Least share of its own reach (farthest displacement) a gesture ends away across the floor
 /// to have gone somewhere, an action's every example and each performance of it alike. The
-/// project's generator at noise ×3: a jump's examples 0.29–1.0 (60 of them), a lift set back
-/// down 0.01–0.23 (20), a punch's or a crouch's least example under 0.2.
+/// project's generator at noise ×3, read from the logs' poses (first and last sample against
+/// the farthest): a jump's examples 0.29–1.0 (60 of them), a lift set back down 0.01–0.23
+/// (20); learnt by ten ×3 libraries, a punch's, crouch's, bow's or throw's least share
+/// 0.01–0.19, a jump's 0.38–0.76.
 pub const AWAY_SHARE: f32 = 0.25;
 /// Share of the other dimension's least extent (rotation × [`ARM_M`]) a dimension must reach
 /// to carry an action: a punch barely turns and a turn barely moves; a kick and a throw carry
@@ -170,9 +172,10 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
 pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
+    let fidget_moved = fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]);
     let need_moved = fmath::max(
         fmath::min(ACCEPT_SHARE * least.moved_m, ENOUGH_MOVED_M),
-        fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]),
+        fidget_moved,
     );
     let need_turned = fmath::max(
         fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD),
@@ -191,10 +194,9 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     };
     // And it went somewhere when each of its examples did: a jump that went 20 cm lands 5 cm
     // or more ahead, where a toy lifted 20 cm comes down within a fidget of where it rose.
-    let slack = fmath::norm3([FIDGET_MOVED_M, noise.moved_m, 0.0]);
     let ends_away = moved < CARRY_SHARE * turned
         || least.travel_share < AWAY_SHARE
-        || went.travel_m + slack >= AWAY_SHARE * went.moved_m;
+        || went.travel_m + fidget_moved >= AWAY_SHARE * went.moved_m;
     went.travel_m >= need_travel
         && ends_away
         && ((moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
