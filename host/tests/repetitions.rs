@@ -48,13 +48,11 @@ fn exactly(got: &[Vec<String>], expected: &[&str]) -> usize {
 #[test]
 fn two_jumps_with_a_breath_between_are_two_jumps() {
     let strong = Effort::STATES[0];
-    let got = recognised(Action::Jump, strong, 2, 0..20);
+    let got = recognised(Action::Jump, strong, 2, 0..6);
     // Before one jump's edit budget stopped swallowing the next, most were one event. (A
     // sudden-strong jump's rise lasts about 50 ms, near the token's least duration: now and
-    // then it is not tokenised, and that jump is no jump.) Over 20 doodles rather than 6,
-    // where one doodle decided the test: 15 are two jumps (16 before motion was read from
-    // the steady velocity, `filter`; over 30, 23 and 24).
-    assert!(exactly(&got, &["jump", "jump"]) >= 14, "{got:?}");
+    // then it is not tokenised, and that jump is no jump.)
+    assert!(exactly(&got, &["jump", "jump"]) >= 4, "{got:?}");
 }
 
 #[test]

@@ -60,12 +60,9 @@ pub const FIDGET_MOVED_M: f32 = 0.010;
 pub const FIDGET_TURNED_RAD: f32 = 0.10;
 /// How far the tracker's noise alone seems to take the figurine, per unit of its learnt
 /// velocity noise rms (s): the farthest point of a phrase is read from the Savitzky–Golay
-/// smoothed pose at its runs' ends, and white position noise that makes a steady velocity
-/// rms σᵥ ([`crate::filter::Smoothed::steady`]) puts two such readings √2·σ apart with
-/// σ ≈ 0.031 s × σᵥ at 100–1000 Hz, about 0.043 s for the two; the farthest of a few
-/// readings lies a little farther. Read as far as the cubic's velocity made it before
-/// (0.083 s), real gestures are rejected with the noise: `figurine eval --pairs 10 --seed
-/// 21000 --train-seed 21 --isolated 30 --sequences 20` isolated 97.5 % (from 97.8).
+/// smoothed pose at its runs' ends, and white position noise that makes a velocity rms σᵥ
+/// puts two such readings √2·σ apart with σ ≈ 0.026 s × σᵥ at 100–1000 Hz (0.036 s at
+/// 30 Hz); the farthest of a few readings lies about 1.5–2 times that.
 pub const NOISE_REACH_S: f32 = 0.05;
 /// Least share of its own reach (farthest displacement) a gesture ends away across the floor
 /// to have gone somewhere, an action's every example and each performance of it alike. The

@@ -44,21 +44,13 @@ fn pick(d: &[f32; 7], off: usize) -> [f32; 4] {
     [d[off], d[off + 1], d[off + 2], d[off + 3]]
 }
 
-/// The smoothed orientation `q` made unit, and 1/|q|².
-fn unit(q: [f32; 4]) -> ([f32; 4], f32) {
-    let n2 = fmath::qdot(q, q);
-    let inv_n2 = if n2 > 1e-12 { 1.0 / n2 } else { 1.0 };
-    let inv_n = fmath::sqrt(inv_n2);
-    (
-        [q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n],
-        inv_n2,
-    )
-}
-
 /// Computes the object-frame kinematics of a filtered tick.
 pub fn kinematics(s: &Smoothed) -> Kinematics {
     let q = pick(&s.d[0], 3);
-    let (qu, inv_n2) = unit(q);
+    let n2 = fmath::qdot(q, q);
+    let inv_n2 = if n2 > 1e-12 { 1.0 / n2 } else { 1.0 };
+    let inv_n = fmath::sqrt(inv_n2);
+    let qu = [q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n];
     let qd = pick(&s.d[1], 3);
     let qdd = pick(&s.d[2], 3);
     let qddd = pick(&s.d[3], 3);
@@ -82,21 +74,6 @@ pub fn kinematics(s: &Smoothed) -> Kinematics {
         world_v,
         world_a,
         world_j,
-    }
-}
-
-/// The kinematics `k` of tick `s` with its velocities (object-frame linear and angular, and
-/// world linear) read steadily ([`Smoothed::steady`]): what the tokenizer judges motion by.
-/// Accelerations and jerks stay the cubic's.
-pub fn steady(s: &Smoothed, k: &Kinematics) -> Kinematics {
-    let q = pick(&s.d[0], 3);
-    let (qu, inv_n2) = unit(q);
-    let world_v = [s.steady[0], s.steady[1], s.steady[2]];
-    Kinematics {
-        v: fmath::rotate_inv(qu, world_v),
-        w: vec_part(fmath::qmul(fmath::qconj(q), pick(&s.steady, 3)), inv_n2),
-        world_v,
-        ..*k
     }
 }
 

@@ -10,7 +10,7 @@
 
 use crate::features::{Accum, FeatureExtractor};
 use crate::filter::SavGol;
-use crate::frame::{kinematics, steady, Kinematics};
+use crate::frame::{kinematics, Kinematics};
 use crate::history::History;
 use crate::intake::{Accept, Intake, IntakeCounters, Sample};
 use crate::token::{Token, TokenStep, Tokenizer, STILL};
@@ -103,11 +103,8 @@ impl Frontend {
             let Some(sm) = self.filter.push(tick) else {
                 continue;
             };
-            // The feature sums (effort, shape) read the cubic's velocities; the tokens, the
-            // rise and how far a gesture went read the steady ones (`filter`: tremor cut).
-            let sharp = kinematics(&sm);
-            let q = self.features.quantities(&sharp);
-            let k = steady(&sm, &sharp);
+            let k = kinematics(&sm);
+            let q = self.features.quantities(&k);
             let rise = k.world_v[1] * crate::intake::TICK_S;
             let at = (k.tick.seq, k.tick.sample_t_us);
             self.ticks = self.ticks.saturating_add(1);

@@ -36,13 +36,9 @@ pub const BLOCKS: usize = 6;
 /// floor) in either vector moved somewhere: it is not noise.
 pub const COHERENCE_MAX: f32 = 0.5;
 /// Time constant (s) of the running mean velocity and speed that tell, tick by tick, whether a
-/// vector goes somewhere: the filter's window (110 ms), over which the steady velocity's
-/// noise stays correlated ([`crate::filter::Smoothed::steady`]), and so longer than a tremor
-/// cycle (8–12 Hz); short beside a stroke. At 0.08 s, a tremor cycle but not the window,
-/// tabletop libraries read a far webcam's depth jitter as strokes about four times as often
-/// (`figurine eval rest --hours 20 --seed S --scale 0.3 --train-seed 10·S`, S = 1, 2, 5, 6:
-/// 0.18 / 0.17 / 0.18 / 0.20 false alarms per hour, against 0.05 / 0.00 / 0.07 / 0.02).
-pub const HEADING_TAU_S: f32 = 0.11;
+/// vector goes somewhere: long enough to average out a tremor cycle (8–12 Hz), short beside a
+/// stroke.
+pub const HEADING_TAU_S: f32 = 0.08;
 /// A vector heads somewhere while its running mean velocity is at least this share of its
 /// running mean speed.
 pub const HEADING_SHARE: f32 = 0.4;
