@@ -215,13 +215,79 @@ pub fn test() -> Result<()> {
 
 /// Runs a `cargo test` command, echoing its output, and sums its `test result:` lines so the
 /// run ends on one total (`N passed, N failed`) rather than on the last crate's doc-tests.
+///
+/// A test binary that dies before its summary (a signal, an abort, a C library calling
+/// `exit`) leaves no `test result:` line; cargo names it, and the binary says why, only on
+/// standard error, far above the end of a long log. So standard error is kept in a ring of
+/// [`DEATH_CONTEXT_LINES`] lines, and each `to rerun pass` block is repeated at the end with
+/// the lines before it, so a CI log's tail says which binary failed and how.
 fn run_tests(cmd: &mut Command) -> Result<(u64, u64)> {
+    let shown = format!("{cmd:?}");
+    let run = collect_tests(cmd)?;
+    if !run.success {
+        if !run.failures.is_empty() {
+            println!(
+                "\nwhat cargo and the test binaries said on standard error before each failure:"
+            );
+            for line in &run.failures {
+                println!("  {line}");
+            }
+        }
+        println!("tests: {} passed, {} failed", run.passed, run.failed);
+        anyhow::bail!("tests failed ({}): {shown}", run.status);
+    }
+    Ok((run.passed, run.failed))
+}
+
+/// What a `cargo test` run printed that [`run_tests`] reports.
+#[derive(Debug)]
+struct TestRun {
+    passed: u64,
+    failed: u64,
+    success: bool,
+    status: String,
+    /// Each failure's standard-error context (see [`run_tests`]), blocks begun by `--`.
+    failures: Vec<String>,
+}
+
+/// Runs `cmd`, echoing both its streams, and gathers a [`TestRun`].
+fn collect_tests(cmd: &mut Command) -> Result<TestRun> {
     use std::io::{BufRead, BufReader};
     let shown = format!("{cmd:?}");
     let mut child = cmd
         .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
         .spawn()
         .with_context(|| format!("could not start {shown}"))?;
+    // Standard error is read on its own thread, so neither pipe can fill and stall cargo.
+    let stderr = child.stderr.take().map(|err| {
+        std::thread::spawn(move || {
+            let mut ring = std::collections::VecDeque::new();
+            let mut failures: Vec<String> = Vec::new();
+            let mut after = 0usize;
+            for line in BufReader::new(err).lines().map_while(|l| l.ok()) {
+                eprintln!("{line}");
+                if after > 0 {
+                    after -= 1;
+                    failures.push(line);
+                    continue;
+                }
+                if line.contains("to rerun pass") {
+                    failures.push("--".to_string());
+                    failures.extend(ring.drain(..));
+                    failures.push(line);
+                    // cargo's "Caused by: process didn't exit successfully: … (signal: …)".
+                    after = 4;
+                    continue;
+                }
+                if ring.len() == DEATH_CONTEXT_LINES {
+                    ring.pop_front();
+                }
+                ring.push_back(line);
+            }
+            failures
+        })
+    });
     let (mut passed, mut failed) = (0u64, 0u64);
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines() {
@@ -242,9 +308,72 @@ fn run_tests(cmd: &mut Command) -> Result<(u64, u64)> {
         }
     }
     let status = child.wait()?;
-    if !status.success() {
-        println!("tests: {passed} passed, {failed} failed");
-        anyhow::bail!("tests failed ({status}): {shown}");
+    let failures = stderr
+        .and_then(|reader| reader.join().ok())
+        .unwrap_or_default();
+    Ok(TestRun {
+        passed,
+        failed,
+        success: status.success(),
+        status: status.to_string(),
+        failures,
+    })
+}
+
+/// Standard-error lines kept before each failed test binary's `to rerun pass` line: enough
+/// for cargo's `Running` line and what a dying binary printed (a panic inside a panic, a
+/// stack overflow, a C library's message).
+const DEATH_CONTEXT_LINES: usize = 12;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stand-in for `cargo test`: a shell that prints what cargo and a test binary print.
+    fn shell(script: &str) -> Command {
+        let mut cmd = Command::new("sh");
+        cmd.args(["-c", script]);
+        cmd
     }
-    Ok((passed, failed))
+
+    #[test]
+    fn results_are_summed_over_every_binary() {
+        let run = collect_tests(&mut shell(
+            "echo 'test result: ok. 3 passed; 0 failed; 1 ignored'; \
+             echo 'test result: FAILED. 2 passed; 1 failed; 0 ignored'; exit 101",
+        ))
+        .unwrap();
+        assert_eq!((run.passed, run.failed, run.success), (5, 1, false));
+    }
+
+    #[test]
+    fn a_binary_that_dies_is_named_with_what_it_said_before() {
+        let run = collect_tests(&mut shell(
+            "echo '     Running unittests src/lib.rs (target/debug/deps/a-1)' >&2; \
+             echo 'test result: ok. 3 passed; 0 failed' ; \
+             echo '     Running unittests src/lib.rs (target/debug/deps/b-2)' >&2; \
+             echo \"thread 'x' has overflowed its stack\" >&2; \
+             echo 'error: test failed, to rerun pass `-p b --lib`' >&2; \
+             echo '' >&2; echo 'Caused by:' >&2; \
+             echo '  process didn'\"'\"'t exit successfully: `b-2` (signal: 6, SIGABRT)' >&2; \
+             exit 101",
+        ))
+        .unwrap();
+        assert!(!run.success);
+        assert_eq!((run.passed, run.failed), (3, 0));
+        let said = run.failures.join("\n");
+        for needle in ["deps/b-2", "overflowed its stack", "-p b --lib", "SIGABRT"] {
+            assert!(said.contains(needle), "{needle} missing from:\n{said}");
+        }
+    }
+
+    #[test]
+    fn a_run_that_passes_keeps_no_failure() {
+        let run = collect_tests(&mut shell(
+            "echo '     Running x' >&2; echo 'test result: ok. 1 passed; 0 failed'",
+        ))
+        .unwrap();
+        assert!(run.success);
+        assert!(run.failures.is_empty());
+    }
 }
