@@ -332,7 +332,32 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// Reads a joint and everything nested in it, up to its closing brace. The open joints are
+    /// kept on a list rather than the call stack, so a file nested as deep as [`MAX_DEPTH`]
+    /// needs no more stack than a flat one (recursing, a debug build used over 1 MiB there:
+    /// half a test thread's stack).
     fn parse_joint(&mut self, parent: Option<usize>) -> Result<(), MotionError> {
+        let mut open = vec![self.parse_joint_header(parent)?];
+        while let Some(&index) = open.last() {
+            let t = self
+                .next()
+                .ok_or_else(|| self.err("unexpected end of file inside a joint"))?;
+            if t == "}" {
+                open.pop();
+            } else if t.eq_ignore_ascii_case("JOINT") {
+                open.push(self.parse_joint_header(Some(index))?);
+            } else if t.eq_ignore_ascii_case("End") {
+                self.expect("Site")?;
+                self.parse_end_site(index)?;
+            } else {
+                return Err(self.err(format!("expected `JOINT`, `End Site` or `}}`, found `{t}`")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads a joint's name, `{`, OFFSET and CHANNELS, and adds it; returns its index.
+    fn parse_joint_header(&mut self, parent: Option<usize>) -> Result<usize, MotionError> {
         let depth = parent.map_or(0, |p| self.depth_of(p) + 1);
         if depth > MAX_DEPTH {
             return Err(self.err(format!("joints nested deeper than {MAX_DEPTH}")));
@@ -383,21 +408,7 @@ impl Parser<'_> {
         }
         joint.rotation_order = order_from_channels(&joint.channels);
         self.joints.push(ParsedJoint { joint });
-        loop {
-            let t = self
-                .next()
-                .ok_or_else(|| self.err("unexpected end of file inside a joint"))?;
-            if t == "}" {
-                return Ok(());
-            } else if t.eq_ignore_ascii_case("JOINT") {
-                self.parse_joint(Some(index))?;
-            } else if t.eq_ignore_ascii_case("End") {
-                self.expect("Site")?;
-                self.parse_end_site(index)?;
-            } else {
-                return Err(self.err(format!("expected `JOINT`, `End Site` or `}}`, found `{t}`")));
-            }
-        }
+        Ok(index)
     }
 
     fn parse_end_site(&mut self, parent: usize) -> Result<(), MotionError> {
