@@ -11,6 +11,7 @@ use figurine_protocol::pose::{Pose, SeqUnwrapper, TimeUnwrapper};
 use figurine_recognizer::features::Accum;
 use figurine_recognizer::frontend::{FrontEvent, Frontend};
 use figurine_recognizer::history::Run;
+use figurine_recognizer::noise::{ON_FACTOR, V_FLOOR_M_S, W_FLOOR_RAD_S};
 use figurine_recognizer::token::STILL;
 use figurine_recognizer::{ActionEvent, EffortModel, Library, Note, Recognizer, Sample};
 
@@ -144,6 +145,22 @@ pub fn log_events(
 /// All token runs of a log (STILL included), in order, with their feature sums.
 pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
     log_runs_and_noise(samples).0
+}
+
+/// What a log that read as no motion at all would have needed, in words: the least stroke
+/// (cm/s) and twist (°/s) that stand out — the fixed floors, or [`ON_FACTOR`] × the noise the
+/// front end learnt from the log (`lin_rms` m/s, `rot_rms` rad/s, from
+/// [`log_runs_and_noise`]).
+pub fn nothing_moved_words(lin_rms: f32, rot_rms: f32) -> String {
+    format!(
+        "nothing moved: a stroke must pass {:.1} cm/s or a twist {:.0}°/s — the floors, or \
+         {ON_FACTOR} × the tracker's noise the device learnt from the stream ({:.1} cm/s, \
+         {:.0}°/s rms); play bigger or faster",
+        100.0 * V_FLOOR_M_S.max(ON_FACTOR * lin_rms),
+        W_FLOOR_RAD_S.max(ON_FACTOR * rot_rms).to_degrees(),
+        100.0 * lin_rms,
+        rot_rms.to_degrees()
+    )
 }
 
 /// [`log_runs`], and the tracker's noise the front end learnt from the log by its end: rms

@@ -16,7 +16,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use figurine_recognizer::extent::{Extent, ExtentSums};
 use figurine_recognizer::features::{Shape, ShapeSums};
@@ -26,7 +26,9 @@ use figurine_recognizer::token::STILL;
 
 use super::columns::learn_regex;
 use super::dtw;
-use super::feed::{gesture_runs, log_gesture, log_runs, log_samples};
+use super::feed::{
+    gesture_runs, log_gesture, log_runs, log_runs_and_noise, log_samples, nothing_moved_words,
+};
 use super::intent::{intent_of, intent_symbols, mirror_seq, run_seconds, tokens_only, Tokenized};
 use super::library::{full_match, parse_tokens, tokens_to_string, ActionEntry, LibraryFile};
 use super::regex::default_edits;
@@ -283,6 +285,14 @@ pub fn collisions(lib: &LibraryFile, entry: &ActionEntry) -> Result<Vec<String>>
     Ok(out)
 }
 
+/// Why example `log` read as no motion: the least stroke and twist that would have stood out
+/// of its tracker's noise ([`nothing_moved_words`]).
+fn still_words(log: &PoseLog) -> String {
+    let (samples, _) = log_samples(log);
+    let (_, (lin, rot)) = log_runs_and_noise(&samples);
+    nothing_moved_words(lin, rot)
+}
+
 /// `figurine learn`.
 pub fn run(args: &LearnArgs) -> Result<()> {
     let mut lib = if args.library.exists() {
@@ -295,9 +305,28 @@ pub fn run(args: &LearnArgs) -> Result<()> {
         .iter()
         .map(|p| PoseLog::read_path(p).map_err(anyhow::Error::from))
         .collect::<Result<Vec<_>>>()?;
-    let entry = learn_action(&args.name, &logs, args.max_edits, !args.no_mirror)
-        .with_context(|| format!("learning `{}`", args.name))?;
-    for (p, ex) in args.examples.iter().zip(&entry.examples) {
+    let entry = match learn_action(&args.name, &logs, args.max_edits, !args.no_mirror) {
+        Ok(entry) => entry,
+        Err(e) if logs.iter().all(|l| log_gesture(l).is_empty()) => {
+            let why: Vec<String> = args
+                .examples
+                .iter()
+                .zip(&logs)
+                .map(|(p, l)| format!("{}: {}", p.display(), still_words(l)))
+                .collect();
+            return Err(e.context(format!(
+                "learning `{}`: no example moved enough to read\n  {}",
+                args.name,
+                why.join("\n  ")
+            )));
+        }
+        Err(e) => return Err(e.context(format!("learning `{}`", args.name))),
+    };
+    for ((p, ex), log) in args.examples.iter().zip(&entry.examples).zip(&logs) {
+        if ex.is_empty() {
+            eprintln!("  {}: left out, {}", p.display(), still_words(log));
+            continue;
+        }
         let t = parse_tokens(ex)?;
         let ok = full_match(&entry, &t)?;
         eprintln!(

@@ -14,7 +14,6 @@ use anyhow::{Context, Result};
 use clap::Args;
 use figurine_recognizer::history::Run;
 use figurine_recognizer::intake::MAX_GAP_US;
-use figurine_recognizer::noise::{ON_FACTOR, V_FLOOR_M_S, W_FLOOR_RAD_S};
 use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
 use figurine_recognizer::token::{Token, STILL};
 use figurine_recognizer::{
@@ -23,7 +22,9 @@ use figurine_recognizer::{
 
 use super::columns::edit_distance;
 use super::effort_model::EffortFile;
-use super::feed::{log_runs_and_noise, log_samples, recognize_log_noted, Clock};
+use super::feed::{
+    log_runs_and_noise, log_samples, nothing_moved_words, recognize_log_noted, Clock,
+};
 use super::library::{parse_tokens, tokens_to_string, LibraryFile};
 use crate::events::{write_event, ActionRecord};
 use crate::poselog::PoseLog;
@@ -251,15 +252,7 @@ pub fn unread_lines(sim: &Simulation, lib: &LibraryFile) -> Result<Vec<NoteLine>
             action: "(none)".into(),
             start: time(first.start.0),
             end: time(last.end.0),
-            words: format!(
-                "nothing moved: a stroke must pass {:.1} cm/s or a twist {:.0}°/s — the \
-                 floors, or {ON_FACTOR} × the tracker's noise the device learnt from the \
-                 stream ({:.1} cm/s, {:.0}°/s rms); play bigger or faster",
-                100.0 * V_FLOOR_M_S.max(ON_FACTOR * lin_rms),
-                W_FLOOR_RAD_S.max(ON_FACTOR * rot_rms).to_degrees(),
-                100.0 * lin_rms,
-                rot_rms.to_degrees()
-            ),
+            words: nothing_moved_words(lin_rms, rot_rms),
         }]);
     }
     let mut phrases: Vec<Vec<&Run>> = vec![Vec::new()];
