@@ -47,11 +47,10 @@ use crate::token::ARM_M;
 pub const ACCEPT_SHARE: f32 = 0.15;
 /// Displacement that is far enough for any action, m, however far its examples went: a hand
 /// holding the figurine still shifts it by millimetres, never 2 cm, and a child who plays a
-/// library learnt at arm's length on a tabletop goes a fraction of its examples.
+/// library learnt at arm's length on a tabletop goes a fraction of its examples. Rotation has
+/// no such bound: a doodle's size scales how far it moves, not how far it turns (a quarter
+/// turn is a quarter turn on a tabletop), and a webcam's tilt jitter at 1 m reaches 5–10°.
 pub const ENOUGH_MOVED_M: f32 = 0.02;
-/// Rotation that is far enough for any action, rad (about 9°): a resting hand tilts the
-/// figurine by a few degrees.
-pub const ENOUGH_TURNED_RAD: f32 = 0.15;
 /// Displacement that is never far enough for an action, m, whatever its examples: just beyond
 /// the largest shift a hand's fidget makes (2–8 mm in `figurine synth rest`).
 pub const FIDGET_MOVED_M: f32 = 0.010;
@@ -163,8 +162,8 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
 }
 
 /// Whether motion that went `went` went far enough to be an action whose least example went
-/// `least`: at least [`ACCEPT_SHARE`] of it (or [`ENOUGH_MOVED_M`], [`ENOUGH_TURNED_RAD`])
-/// in a dimension that carries the action, and as far across the floor when moving carries
+/// `least`: at least [`ACCEPT_SHARE`] of it (of a displacement, or [`ENOUGH_MOVED_M`] if
+/// less) in a dimension that carries the action, and as far across the floor when moving carries
 /// it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved, and
 /// farther than a fidget), and ends [`AWAY_SHARE`] of its own reach away when each of its
 /// examples did ([`Extent::travel_share`]). A fidget seen through a tracker's `noise` ([`noise_reach`])
@@ -178,7 +177,7 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
         fidget_moved,
     );
     let need_turned = fmath::max(
-        fmath::min(ACCEPT_SHARE * least.turned_rad, ENOUGH_TURNED_RAD),
+        ACCEPT_SHARE * least.turned_rad,
         fmath::norm3([FIDGET_TURNED_RAD, noise.turned_rad, 0.0]),
     );
     // Travel is part of moving: it carries an action that moving carries, when its examples
@@ -322,6 +321,21 @@ mod tests {
         // Examples that went nowhere admit anything that goes farther than a fidget.
         assert!(far_enough(ext(0.012, 0.0), Extent::default(), QUIET));
         assert!(!far_enough(Extent::default(), Extent::default(), QUIET));
+    }
+
+    #[test]
+    fn a_small_doodle_moves_less_but_turns_as_far() {
+        // A run learnt at arm's length (72 cm): a 3 cm tabletop run is far enough.
+        let run = ext(0.72, 0.1);
+        assert!(far_enough(ext(0.03, 0.0), run, QUIET));
+        // A turn learnt at 136°: a 10° wobble there and back (a webcam's tilt jitter at 1 m)
+        // is no turn, however small the doodle; a 30° turn is.
+        let turn = ext(0.009, 2.37);
+        assert!(!far_enough(ext(0.0, 0.17), turn, QUIET));
+        assert!(far_enough(ext(0.0, 0.52), turn, QUIET));
+        // A bow learnt at 43° still admits a 10° nod.
+        let bow = ext(0.024, 0.75);
+        assert!(far_enough(ext(0.0, 0.17), bow, QUIET));
     }
 
     #[test]
