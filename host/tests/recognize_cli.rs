@@ -446,20 +446,21 @@ fn learn_says_why_an_example_that_read_as_nothing_was_left_out() {
     let d = tmp("learn-still");
     let (big, tiny, tiny2) = (d.join("big.csv"), d.join("tiny.csv"), d.join("tiny2.csv"));
     stroke_of(&big, 0.3, 0.05);
-    // 2 mm in a second: 0.3 cm/s at its fastest, under the 7 cm/s floor.
+    // 2 mm in a second: 0.4 cm/s at its fastest, under the 7 cm/s floor.
     stroke_of(&tiny, 1.0, 0.002);
     stroke_of(&tiny2, 1.0, -0.002);
-    let lib = d.join("lib.json");
-    let lib_arg = lib.to_str().unwrap();
-    let out = figurine(&[
-        "learn",
-        "--library",
-        lib_arg,
-        "--name",
-        "left",
-        big.to_str().unwrap(),
-        tiny.to_str().unwrap(),
-    ]);
+    let learn = |lib: &Path, examples: &[&Path]| {
+        let mut args = vec![
+            "learn",
+            "--library",
+            lib.to_str().unwrap(),
+            "--name",
+            "left",
+        ];
+        args.extend(examples.iter().map(|p| p.to_str().unwrap()));
+        figurine(&args)
+    };
+    let out = learn(&d.join("lib.json"), &[&big, &tiny]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     let line = err
@@ -473,15 +474,7 @@ fn learn_says_why_an_example_that_read_as_nothing_was_left_out() {
     assert!(err.contains("big.csv: l  [matched"), "{err}");
     // Every example still: an error that says so for each, and no library written.
     let lib2 = d.join("lib2.json");
-    let out = figurine(&[
-        "learn",
-        "--library",
-        lib2.to_str().unwrap(),
-        "--name",
-        "left",
-        tiny.to_str().unwrap(),
-        tiny2.to_str().unwrap(),
-    ]);
+    let out = learn(&lib2, &[&tiny, &tiny2]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(err.contains("no example moved enough to read"), "{err}");
