@@ -12,7 +12,8 @@
 //! near 3 Hz, so the filter would smooth least where the jitter is worst. So the rate that
 //! opens it is the measured rate less the jitter's, in power (the two are independent): the
 //! jitter's rate is [`FLOOR_FACTOR`] × a floor learnt from the stream as the recognizer learns
-//! its noise (minimum statistics: the quietest of the last [`FLOOR_BLOCKS`] blocks' mean rate).
+//! its noise (minimum statistics: the quietest of the last [`FLOOR_BLOCKS`] blocks' mean rate,
+//! among blocks whose net turn is under [`COHERENCE_MAX`] of their path: a turn is no jitter).
 //!
 //! | measured rate r, jitter's j | cut-off |
 //! |---|---|
@@ -34,6 +35,9 @@ pub const FLOOR_BLOCK_S: f64 = 0.25;
 /// Blocks among which the quietest sets the jitter floor: 4 s, longer than a gesture, so
 /// that a rest is among them while the figurine plays.
 pub const FLOOR_BLOCKS: usize = 16;
+/// A block counts toward the jitter floor only if the tag's net turn over it stays below this
+/// share of the turns summed frame to frame (the recognizer's `noise::COHERENCE_MAX`).
+pub const COHERENCE_MAX: f64 = 0.5;
 /// Multiple of the jitter floor taken as a held tag's jitter: the quietest block's mean
 /// lies below a typical block's, and the low-passed rate swings about that (at 2, a held tag
 /// still fired 8 actions in 78 minutes of the track bench's holds; at 3, 2).
@@ -53,36 +57,52 @@ pub struct OrientationFilter {
 }
 
 /// The measured turn rate of a tag at rest: the quietest of the last [`FLOOR_BLOCKS`] blocks'
-/// mean rate (minimum statistics, as the recognizer learns its noise).
+/// mean rate (minimum statistics, as the recognizer learns its noise), among the blocks that
+/// went nowhere: jitter turns the tag to and fro, a turn takes it somewhere, and a steady
+/// turn longer than the window must not be learnt as jitter.
 #[derive(Debug, Clone, Default)]
 struct JitterFloor {
     /// Σ rate, samples, and the first sample's time of the block being filled.
     sum: f64,
     n: u32,
     start: f64,
-    /// Mean rate of the last closed blocks (rad/s), oldest overwritten first.
+    /// The measured orientation where the block began, and the last one.
+    from: Option<DQuat>,
+    last: Option<DQuat>,
+    /// Σ of the turns between the block's measured orientations, rad.
+    path: f64,
+    /// Mean rate of the last counted blocks (rad/s), oldest overwritten first.
     means: [f64; FLOOR_BLOCKS],
-    closed: usize,
+    counted: usize,
 }
 
 impl JitterFloor {
-    /// Adds the rate measured at `t` seconds.
-    fn push(&mut self, t: f64, rate: f64) {
+    /// Adds the rate measured at `t` seconds with the measured orientation `q`.
+    fn push(&mut self, t: f64, rate: f64, q: DQuat) {
         if self.n == 0 {
             self.start = t;
+            self.from = self.last.or(Some(q));
+            self.path = 0.0;
         }
+        if let Some(last) = self.last {
+            self.path += last.angle_between(q);
+        }
+        self.last = Some(q);
         self.sum += rate;
         self.n += 1;
         if t - self.start >= FLOOR_BLOCK_S {
-            self.means[self.closed % FLOOR_BLOCKS] = self.sum / f64::from(self.n);
-            self.closed += 1;
+            let net = self.from.map_or(0.0, |from| from.angle_between(q));
+            if net < COHERENCE_MAX * self.path {
+                self.means[self.counted % FLOOR_BLOCKS] = self.sum / f64::from(self.n);
+                self.counted += 1;
+            }
             (self.sum, self.n) = (0.0, 0);
         }
     }
 
-    /// The floor, rad/s (0 until two blocks have closed).
+    /// The floor, rad/s (0 until two blocks have counted).
     fn rate(&self) -> f64 {
-        let known = &self.means[..self.closed.min(FLOOR_BLOCKS)];
+        let known = &self.means[..self.counted.min(FLOOR_BLOCKS)];
         if known.len() < 2 {
             return 0.0;
         }
@@ -107,7 +127,7 @@ impl OrientationFilter {
         let q = if q.dot(prev) < 0.0 { -q } else { q };
         let raw_rate = prev.angle_between(q) / dt;
         self.rate += alpha(RATE_CUTOFF_HZ, dt) * (raw_rate - self.rate);
-        self.floor.push(t, raw_rate);
+        self.floor.push(t, raw_rate, q);
         // Motion and jitter are independent: their rates add in power.
         let jitter = FLOOR_FACTOR * self.floor.rate();
         let moving = (self.rate * self.rate - jitter * jitter).max(0.0).sqrt();
