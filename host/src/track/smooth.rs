@@ -74,6 +74,8 @@ struct JitterFloor {
     /// Mean rate of the last counted blocks (rad/s), oldest overwritten first.
     means: [f64; FLOOR_BLOCKS],
     counted: usize,
+    /// The quietest of `means` once two have counted, else 0 (rad/s).
+    floor: f64,
 }
 
 impl JitterFloor {
@@ -95,6 +97,10 @@ impl JitterFloor {
             if net < COHERENCE_MAX * self.path {
                 self.means[self.counted % FLOOR_BLOCKS] = self.sum / f64::from(self.n);
                 self.counted += 1;
+                let known = &self.means[..self.counted.min(FLOOR_BLOCKS)];
+                if known.len() >= 2 {
+                    self.floor = known.iter().copied().fold(f64::INFINITY, f64::min);
+                }
             }
             (self.sum, self.n) = (0.0, 0);
         }
@@ -102,11 +108,7 @@ impl JitterFloor {
 
     /// The floor, rad/s (0 until two blocks have counted).
     fn rate(&self) -> f64 {
-        let known = &self.means[..self.counted.min(FLOOR_BLOCKS)];
-        if known.len() < 2 {
-            return 0.0;
-        }
-        known.iter().copied().fold(f64::INFINITY, f64::min)
+        self.floor
     }
 }
 
