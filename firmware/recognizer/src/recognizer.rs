@@ -22,9 +22,7 @@ use crate::intake::{IntakeCounters, Sample};
 use crate::nearest::{nearest_action, whole_phrase, Nearest, OPEN_PHRASE_US};
 use crate::note::{Note, Why};
 use crate::pattern::{Library, MAX_ACTIONS};
-use crate::segment::{
-    Candidate, Decider, Decision, CONTINUE_US, GAPPED_HOLD_US, LONG_PAUSE_US, PAUSE_US,
-};
+use crate::segment::{Candidate, Decider, Decision, CONTINUE_US, LONG_PAUSE_US, PAUSE_US};
 use crate::token::{Token, STILL};
 
 mod candidate;
@@ -108,7 +106,7 @@ pub struct Recognizer<'lib> {
     /// as it was before the report and whether the report continued it.
     provisional: Option<(Candidate, Option<Held>, bool)>,
     /// The STILL run last checked for a longer action in progress, and the answer.
-    hold: Option<(u32, bool)>,
+    hold: Option<(u32, Option<u64>)>,
     /// The STILL run after which the phrase before it was last offered to [`nearest_action`],
     /// and the answer (None once acted on).
     nearest: Option<(u32, Option<Nearest>)>,
@@ -224,7 +222,7 @@ impl<'lib> Recognizer<'lib> {
                 // so what is checked then holds for all of it.
                 let mut first = false;
                 let longer = match (self.decider.pending(), newest) {
-                    (Some(p), Some(run)) if (PAUSE_US..GAPPED_HOLD_US).contains(&still) => {
+                    (Some(p), Some(run)) if (PAUSE_US..LONG_PAUSE_US).contains(&still) => {
                         match self.hold {
                             Some((r, v)) if r == run => v,
                             _ => {
@@ -235,7 +233,7 @@ impl<'lib> Recognizer<'lib> {
                             }
                         }
                     }
-                    _ => false,
+                    _ => None,
                 };
                 if let Decision::Commit(c) = self.decider.stillness(still, longer) {
                     let (floor, bounds) = if self.provisional.is_some() {
@@ -260,7 +258,11 @@ impl<'lib> Recognizer<'lib> {
                     // waited for its next stride; a crouch right after a wave's last stroke) is
                     // read afresh, as after a commit at a token.
                     self.feed_from(self.floor, out);
-                } else if let Some(p) = self.decider.pending().filter(|p| longer || p.cyclic) {
+                } else if let Some(p) = self
+                    .decider
+                    .pending()
+                    .filter(|p| longer.is_some() || p.cyclic)
+                {
                     // Held for a longer action that may yet take it over, or for the next
                     // cycle of a cyclic one: reported after the usual pause (weighed once per
                     // pause, not on every sample of it), and revised if it is taken over or

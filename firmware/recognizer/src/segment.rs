@@ -17,7 +17,9 @@
 //!   whose pattern repeats as a whole; up to [`HOLD_US`] — [`INEXACT_HOLD_US`] when it
 //!   needed near substitutions, [`GAPPED_HOLD_US`] when it needed a whole edit — while another
 //!   action has matched further than it exactly, or, for a candidate that needed a whole
-//!   edit, at a lower cost, and may go on after the hold), or
+//!   edit, at a lower cost, and may go on after the hold; and, when the pending candidate is
+//!   shorter than that action's shortest match, a piece of it, as long as that action's
+//!   examples held still inside ([`crate::pattern::Library::hold_us`])), or
 //! - the stream ends ([`crate::Recognizer::flush`]).
 //!
 //! After a commit, matching restarts just after the committed segment (the tokens seen during
@@ -228,9 +230,10 @@ impl Decider {
     /// The current run is STILL and has lasted `still_us`: commits after [`PAUSE_US`] —
     /// or after [`HOLD_US`] ([`INEXACT_HOLD_US`] if the pending candidate needed a near
     /// substitution, [`GAPPED_HOLD_US`] if it needed a whole edit) while
-    /// `longer_in_progress` (a longer action has matched further than the pending one and may
-    /// go on after the hold).
-    pub fn stillness(&mut self, still_us: u64, longer_in_progress: bool) -> Decision {
+    /// `longer_in_progress` is `Some` (a longer action has matched further than the pending one
+    /// and may go on after the hold), and for as long as the hold it carries (µs: how long the
+    /// examples of the action it is a piece of held still inside) if that is longer.
+    pub fn stillness(&mut self, still_us: u64, longer_in_progress: Option<u64>) -> Decision {
         let Some(p) = self.pending else {
             return Decision::Wait;
         };
@@ -242,7 +245,8 @@ impl Decider {
         } else {
             HOLD_US
         };
-        if still_us >= pause && (still_us >= hold || !longer_in_progress) {
+        let hold = longer_in_progress.map_or(hold, |learnt| hold.max(learnt));
+        if still_us >= pause && (still_us >= hold || longer_in_progress.is_none()) {
             Decision::Commit(p)
         } else {
             Decision::Wait
@@ -361,40 +365,53 @@ mod tests {
         );
         let mut d = Decider::new();
         d.offer(Some(c(0, 2, 3, 0)), 0);
-        assert_eq!(d.stillness(PAUSE_US - 1, false), Decision::Wait);
+        assert_eq!(d.stillness(PAUSE_US - 1, None), Decision::Wait);
+        assert_eq!(d.stillness(PAUSE_US, None), Decision::Commit(c(0, 2, 3, 0)));
         assert_eq!(
-            d.stillness(PAUSE_US, false),
-            Decision::Commit(c(0, 2, 3, 0))
-        );
-        assert_eq!(
-            Decider::new().stillness(10 * PAUSE_US, false),
+            Decider::new().stillness(10 * PAUSE_US, None),
             Decision::Wait
         );
         // A longer action in progress: the pause is a hold inside it.
         let mut d = Decider::new();
         d.offer(Some(c(0, 2, 3, 0)), 0);
-        assert_eq!(d.stillness(PAUSE_US, true), Decision::Wait);
-        assert_eq!(d.stillness(HOLD_US, true), Decision::Commit(c(0, 2, 3, 0)));
+        assert_eq!(d.stillness(PAUSE_US, Some(0)), Decision::Wait);
+        assert_eq!(
+            d.stillness(HOLD_US, Some(0)),
+            Decision::Commit(c(0, 2, 3, 0))
+        );
         // An inexact pending candidate is the weaker reading of a long hold: it waits longer,
         // the longer the more it needed.
         let mut d = Decider::new();
         d.offer(Some(c(0, 1, 3, 1)), 0);
-        assert_eq!(d.stillness(HOLD_US, true), Decision::Wait);
-        assert_eq!(d.stillness(GAPPED_HOLD_US - 1, true), Decision::Wait);
+        assert_eq!(d.stillness(HOLD_US, Some(0)), Decision::Wait);
+        assert_eq!(d.stillness(GAPPED_HOLD_US - 1, Some(0)), Decision::Wait);
         assert_eq!(
-            d.stillness(GAPPED_HOLD_US, true),
+            d.stillness(GAPPED_HOLD_US, Some(0)),
             Decision::Commit(c(0, 1, 3, 1))
         );
-        assert_eq!(
-            d.stillness(PAUSE_US, false),
-            Decision::Commit(c(0, 1, 3, 1))
-        );
+        assert_eq!(d.stillness(PAUSE_US, None), Decision::Commit(c(0, 1, 3, 1)));
         let mut near = c(0, 1, 3, 0);
         near.cost = 1;
         let mut d = Decider::new();
         d.offer(Some(near), 0);
-        assert_eq!(d.stillness(INEXACT_HOLD_US - 1, true), Decision::Wait);
-        assert_eq!(d.stillness(INEXACT_HOLD_US, true), Decision::Commit(near));
+        assert_eq!(d.stillness(INEXACT_HOLD_US - 1, Some(0)), Decision::Wait);
+        assert_eq!(
+            d.stillness(INEXACT_HOLD_US, Some(0)),
+            Decision::Commit(near)
+        );
+        // A piece of an action whose examples held still 1.4 s inside waits that long; a hold
+        // learnt shorter than the fixed one does not shorten it.
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 2, 3, 0)), 0);
+        assert_eq!(d.stillness(HOLD_US, Some(1_400_000)), Decision::Wait);
+        assert_eq!(d.stillness(1_399_999, Some(1_400_000)), Decision::Wait);
+        assert_eq!(
+            d.stillness(1_400_000, Some(1_400_000)),
+            Decision::Commit(c(0, 2, 3, 0))
+        );
+        let mut d = Decider::new();
+        d.offer(Some(c(0, 2, 3, 0)), 0);
+        assert_eq!(d.stillness(HOLD_US - 1, Some(100_000)), Decision::Wait);
     }
 
     #[test]

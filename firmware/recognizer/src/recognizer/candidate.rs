@@ -105,16 +105,15 @@ impl<'lib> Recognizer<'lib> {
     /// full reach after its forward stroke. When `p` needed a whole edit, a match under way
     /// that is not exact but costs less than `p` ([`prefix_cost`]) counts too, begun with `p`
     /// or at its second token: a crouch held low, whose descent a jump explained by taking a
-    /// sideways wobble before it as its lead-in and leaving its hop out.
+    /// sideways wobble before it as its lead-in and leaving its hop out. Some(the hold to wait
+    /// for, µs, from [`under_way`]) when one is; None when none is.
     // Once per pause at most: kept out of the per-sample path (flash, not speed).
     #[cold]
     #[inline(never)]
-    pub(super) fn longer_in_progress(&self, p: &Candidate) -> bool {
+    pub(super) fn longer_in_progress(&self, p: &Candidate) -> Option<u64> {
         // The moving runs from the floor to the newest, oldest first.
         let hist = self.front.history();
-        let Some(newest) = hist.newest() else {
-            return false;
-        };
+        let newest = hist.newest()?;
         let mut tok = [STILL; HISTORY_RUNS];
         let mut n = 0usize;
         let mut at_start = None;
@@ -134,7 +133,7 @@ impl<'lib> Recognizer<'lib> {
             }
             i = i.wrapping_add(1);
         }
-        let Some(ps) = at_start else { return false };
+        let ps = at_start?;
         let moving = tok.get(..n).unwrap_or(&[]);
         // When `p` itself needed a whole edit, another action that explains the same tokens
         // more cheaply and is not finished is as good a reason to wait: a crouch held low
@@ -142,40 +141,60 @@ impl<'lib> Recognizer<'lib> {
         let tolerance = if p.cost >= FULL { p.cost - 1 } else { 0 };
         let alive_from = |from: usize, skip_first: bool| {
             let tokens = moving.get(from..).unwrap_or(&[]);
-            under_way(&self.library, p.action, tokens, skip_first, tolerance)
+            under_way(&self.library, p, tokens, skip_first, tolerance)
         };
         // Begun with the pending candidate, but without its own first part; or, tolerantly,
         // with it or one token into it.
-        alive_from(ps, true)
-            || (tolerance > 0 && (alive_from(ps, false) || alive_from(ps + 1, false)))
+        alive_from(ps, true).or_else(|| {
+            if tolerance > 0 {
+                alive_from(ps, false).or_else(|| alive_from(ps + 1, false))
+            } else {
+                None
+            }
+        })
     }
 }
 
-/// Whether an action other than `skip` has `tokens` (at least one) as the start of a match
-/// that is not over ([`prefix_alive`]; `skip_first`: its own first part skipped) — or, unless
-/// `skip_first`, one that costs at most `tolerance` half-edits so far ([`prefix_cost`]).
+/// Whether an action other than the `pending` candidate's has `tokens` (at least one) as the
+/// start of a match that is not over ([`prefix_alive`]; `skip_first`: its own first part
+/// skipped) — or, unless `skip_first`, one that costs at most `tolerance` half-edits so far
+/// ([`prefix_cost`]). Some(hold, µs) when one has: the longest stillness inside the examples
+/// of those whose shortest match is longer than `pending` (0 for none: a match as long as an
+/// action's least is no piece of it); None when none has.
 // Up to five calls per pause: one out-of-line copy (flash).
 #[inline(never)]
 fn under_way(
     lib: &Library<'_>,
-    skip: u8,
+    pending: &Candidate,
     tokens: &[Token],
     skip_first: bool,
     tolerance: u8,
-) -> bool {
+) -> Option<u64> {
     // Nothing begun is nothing under way (every pattern's start is "not over").
-    !tokens.is_empty()
-        && (0..lib.len()).any(|a| {
-            a != usize::from(skip)
-                && lib.pattern(a).is_some_and(|pat| {
-                    // Its match so far covers all of the tokens and needs more: a longer one.
-                    prefix_alive(&pat, tokens, skip_first)
-                        || (!skip_first
-                            && tolerance > 0
-                            && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
-                                .is_some())
-                })
+    if tokens.is_empty() {
+        return None;
+    }
+    (0..lib.len())
+        .filter_map(|a| {
+            let pat = lib.pattern(a)?;
+            // Its match so far covers all of the tokens and needs more: a longer one.
+            let alive = a != usize::from(pending.action)
+                && (prefix_alive(&pat, tokens, skip_first)
+                    || (!skip_first
+                        && tolerance > 0
+                        && prefix_cost(&pat, tokens, tolerance.min(top_level(&pat) as u8))
+                            .is_some()));
+            // A pending match shorter than that action's least is a piece of it: wait as long
+            // as its examples held still inside.
+            alive.then(|| {
+                if usize::from(pending.len) < pat.min_len() {
+                    lib.hold_us(a)
+                } else {
+                    0
+                }
+            })
         })
+        .max()
 }
 
 #[cfg(test)]
@@ -287,6 +306,32 @@ mod tests {
     }
 
     #[test]
+    fn a_piece_of_an_action_under_way_waits_as_long_as_its_examples_held() {
+        // 0 "jump" `d.Xp d`: the descent alone, exactly; 1 "crouch" `d.Xp d u`, not finished
+        // after the descent. Held low for a second, longer than the usual hold.
+        let blob = crate::pattern::tests::seq_library_ending(&[
+            (&["d.Xp", "d"], 0, 2),
+            (&["d.Xp", "d", "u"], 0, 3),
+        ]);
+        let blob = crate::pattern::tests::with_extents(&blob, &[(0.01, 0.01), (0.01, 0.01)]);
+        let low = crouch_held_low(1.0);
+        let last = |blob: &[u8]| {
+            let lib = Library::from_bytes(blob).unwrap();
+            let ev = run(&lib, &low);
+            ev.last()
+                .map(|e| (e.action, e.start_us < 800_000 && e.end_us > 1_900_000))
+        };
+        // Not learnt to hold that long: the descent is committed as the shorter action.
+        assert_ne!(last(&blob), Some((1, true)));
+        // The crouch's examples held 1.1 s: the descent waits for its rise.
+        let held = crate::pattern::tests::with_hold(&blob, 1, 1_100_000);
+        assert_eq!(last(&held), Some((1, true)));
+        // A hold learnt by the pending match's own action does not make it wait.
+        let own = crate::pattern::tests::with_hold(&blob, 0, 1_100_000);
+        assert_ne!(last(&own), Some((1, true)));
+    }
+
+    #[test]
     fn a_match_that_needed_an_edit_waits_for_a_closer_one_begun_inside_it() {
         // A sideways stroke just before a pitched descent: "jump" explains `r d.Xp d` by
         // leaving its hop out (a whole edit); "crouch" began at the descent, half an edit off
@@ -319,9 +364,28 @@ mod tests {
         let blob = seq_library(&[(&["f"], 0), (&["d", "u"], 1)]);
         let lib = Library::from_bytes(&blob).unwrap();
         let d = crate::token::parse_token("d").unwrap();
-        assert!(under_way(&lib, 0, &[d], false, 0));
+        let pending = |action: u8| Candidate {
+            action,
+            start: 0,
+            end: 0,
+            cost: 0,
+            len: 1,
+            min_len: 1,
+            positions: 1,
+            cyclic: false,
+            shape: 0,
+        };
+        assert_eq!(under_way(&lib, &pending(0), &[d], false, 0), Some(0));
         // Not the pending candidate's own action, and not from no tokens at all.
-        assert!(!under_way(&lib, 1, &[d], false, 0));
-        assert!(!under_way(&lib, 0, &[], false, 1));
+        assert_eq!(under_way(&lib, &pending(1), &[d], false, 0), None);
+        assert_eq!(under_way(&lib, &pending(0), &[], false, 1), None);
+        // The one-token pending match is a piece of "d u": it waits as long as that held.
+        let held = crate::pattern::tests::with_hold(
+            &crate::pattern::tests::with_extents(&blob, &[(0.01, 0.01), (0.01, 0.01)]),
+            1,
+            900_000,
+        );
+        let lib = Library::from_bytes(&held).unwrap();
+        assert_eq!(under_way(&lib, &pending(0), &[d], false, 0), Some(900_000));
     }
 }
