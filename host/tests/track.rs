@@ -241,6 +241,21 @@ fn bad_input_gets_clear_errors() {
         &figurine(&["track", "--video", s(&video), "--out", s(&log)]),
         &["no tag36h11 tag 0 in any of", "frames"],
     );
+    // A camera tilted past straight down, or not a number.
+    for bad in ["95", "NaN"] {
+        fails_saying(
+            &figurine(&[
+                "track",
+                "--video",
+                s(&video),
+                "--camera-tilt",
+                bad,
+                "--out",
+                s(&log),
+            ]),
+            &["--camera-tilt", "degrees (-90 to 90)"],
+        );
+    }
     // Not a video, and no file at all.
     let junk = dir.join("junk.mp4");
     std::fs::write(&junk, b"not a video at all").unwrap();
@@ -349,6 +364,93 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
     assert!(
         (guessed - expected).abs() < 0.015,
         "{guessed} m vs {expected} m"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_camera_looking_down_is_measured_and_its_tilt_undone() {
+    let dir = scratch("tilt");
+    // A figurine standing upright and still for two seconds, 0.6 m along the line of sight of
+    // a camera that looks down 25°, facing it across the desk.
+    let camera = figurine_host::track::pose::camera_tilt(25.0);
+    let at = camera * DVec3::new(0.0, 0.0, -0.6);
+    let log = PoseLog {
+        samples: (0..=60)
+            .map(|i| PoseSample {
+                t: i as f64 / 30.0,
+                pos: at.to_array(),
+                quat: [1.0, 0.0, 0.0, 0.0],
+            })
+            .collect(),
+    };
+    let video = render_as_is(&dir, "down", &log, &["--camera-tilt", "25"]);
+    // Measured from the figurine's own up.
+    let out = succeeds(&["track", "--video", s(&video), "--level"]);
+    let said = String::from_utf8_lossy(&out.stdout).to_string();
+    let tilt: f64 = said
+        .split("looks down ")
+        .nth(1)
+        .and_then(|r| r.split('°').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!((tilt - 25.0).abs() < 2.0, "{said}");
+    // Told the tilt, the log stands upright where the figurine stood; untold, it leans 25°.
+    let up_err = |path: &Path| {
+        let log = PoseLog::read_path(path).unwrap();
+        assert!(log.samples.len() > 50, "{} samples", log.samples.len());
+        let worst = log
+            .samples
+            .iter()
+            .map(|p| {
+                let q = DQuat::from_xyzw(p.quat[1], p.quat[2], p.quat[3], p.quat[0]);
+                (q * DVec3::Y).angle_between(DVec3::Y).to_degrees()
+            })
+            .fold(0.0, f64::max);
+        let far = log
+            .samples
+            .iter()
+            .map(|p| (DVec3::from_array(p.pos) - at).length())
+            .fold(0.0, f64::max);
+        (worst, far)
+    };
+    let told = dir.join("told.csv");
+    succeeds(&[
+        "track",
+        "--video",
+        s(&video),
+        "--camera-tilt",
+        &format!("{tilt}"),
+        "--out",
+        s(&told),
+    ]);
+    let (lean, far) = up_err(&told);
+    assert!(lean < 3.0 && far < 0.01, "leans {lean}°, {far} m off");
+    let untold = dir.join("untold.csv");
+    succeeds(&["track", "--video", s(&video), "--out", s(&untold)]);
+    let (lean, _) = up_err(&untold);
+    assert!(lean > 20.0, "leans {lean}°");
+    // Never still: a clear error, not a made-up tilt.
+    let moving = PoseLog {
+        samples: (0..=60)
+            .map(|i| {
+                let t = i as f64 / 30.0;
+                let q = DQuat::from_rotation_y(0.8 * (2.0 * t).sin());
+                PoseSample {
+                    t,
+                    pos: (at + DVec3::new(0.1 * (3.0 * t).sin(), 0.0, 0.0)).to_array(),
+                    quat: [q.w, q.x, q.y, q.z],
+                }
+            })
+            .collect(),
+    };
+    let video = render_as_is(&dir, "moving", &moving, &["--camera-tilt", "25"]);
+    let out = figurine(&["track", "--video", s(&video), "--level"]);
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("stood still"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -316,6 +316,7 @@ fn a_figurine_held_still_in_view_is_tracked_and_read_for_false_alarms() {
         smooth: true,
         region_search: true,
         exposure_s: 0.008,
+        ..Tracking::default()
     };
     let r = run_still(&setup, 3.0, 7, &dir, how, false).unwrap();
     // 3 s at 30 frames per second, nearly all of them tracked.

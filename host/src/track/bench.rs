@@ -74,6 +74,14 @@ pub struct BenchArgs {
     /// and tag size) instead of rendering them again; a missing one is rendered.
     #[arg(long, requires = "keep")]
     pub reuse: bool,
+    /// How far the rendered camera looks down at the figurine, degrees (0: level, at its
+    /// height; a laptop's webcam looking at a toy on the desk, 20–40).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub camera_tilt: f64,
+    /// How far the tracker is told the camera looks down, degrees (`figurine track
+    /// --camera-tilt`; default: `--camera-tilt`, the truth).
+    #[arg(long, allow_negative_numbers = true)]
+    pub track_tilt: Option<f64>,
     /// Seconds of a figurine held still in a hand at each distance, tracked and read for
     /// false alarms ([`super::still`]; 0: none).
     #[arg(long, default_value_t = 60.0)]
@@ -116,7 +124,7 @@ pub fn run_gesture(
     let mut pick = crate::synth::rng::SynthRng::from_u64(seed);
     let effort = Effort::random_state(&mut pick);
     let doodle = gesture(seed, &knobs(), action, effort);
-    let placed = place(&doodle.log, setup.distance);
+    let placed = place(&doodle.log, setup.distance, setup.camera());
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("{}-{seed}.mp4", action.name()));
     let truths = match kept_truths(reuse, &video, setup, &sc) {
@@ -369,6 +377,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if !(args.fps >= 1.0 && args.fps <= 1000.0) {
         anyhow::bail!("--fps {}: frames per second, 1 to 1000", args.fps);
     }
+    for (flag, deg) in [
+        ("--camera-tilt", args.camera_tilt),
+        ("--track-tilt", args.track_tilt.unwrap_or(0.0)),
+    ] {
+        if !(deg.abs() < 90.0) {
+            anyhow::bail!("{flag} {deg}: how far the camera looks down, degrees (-90 to 90)");
+        }
+    }
     let tmp;
     let dir = match &args.keep {
         Some(d) => {
@@ -398,6 +414,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         smooth: !args.raw,
         region_search: !args.whole_frames,
         exposure_s: args.exposure_ms.max(0.0) / 1000.0,
+        camera_tilt_deg: args.track_tilt.unwrap_or(args.camera_tilt),
     };
     // The camera and picture at the di-th distance, alike for its gestures and its rest.
     let setup_at = |di: usize, distance: f64| Setup {
@@ -406,6 +423,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         seed: args.seed.wrapping_add(di as u64),
         rig_box,
         fps: args.fps,
+        camera_tilt_deg: args.camera_tilt,
         ..Setup::default()
     };
     let mut runs = Vec::new();

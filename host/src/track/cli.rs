@@ -63,7 +63,7 @@ pub struct RunArgs {
     pub calibration: Option<PathBuf>,
     /// Output pose log (CSV); `-` writes to stdout, flushed per sample (pipe it into
     /// `figurine live`).
-    #[arg(long, required_unless_present = "overlay")]
+    #[arg(long, required_unless_present_any = ["overlay", "level"])]
     pub out: Option<PathBuf>,
     /// Also write the first frame where the tag was found, with its corners and the
     /// figurine's axes drawn (PNG).
@@ -86,6 +86,16 @@ pub struct RunArgs {
     /// predicted and undone when the plain search misses it (0: never).
     #[arg(long, default_value_t = DEFAULT_EXPOSURE_S * 1000.0)]
     pub exposure_ms: f64,
+    /// How far the camera looks down, degrees (0: level): the log's world keeps +Y up all the
+    /// same. A laptop's webcam looking at a toy on the desk looks down 20–40°; measured from
+    /// the toy standing upright in view by `figurine track level`.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub camera_tilt: f64,
+    /// Measure how far the camera looks down, from a video (or camera) of the figurine
+    /// standing upright and still in view for a second or two, and print it for
+    /// `--camera-tilt` ([`super::level`]).
+    #[arg(long, conflicts_with = "camera_tilt")]
+    pub level: bool,
     /// Track a rig of tags around the figurine instead of one on its chest: `box` (tags
     /// `--tag-id` … `--tag-id`+3 on the front, left, back and right sides of a box, see
     /// `--box-width`, `--box-depth`) or a rig file (JSON: each tag's id, centre, normal and up
@@ -231,6 +241,9 @@ pub struct RenderArgs {
     rig: Option<String>,
     #[command(flatten)]
     box_size: BoxArgs,
+    /// How far the camera looks down at the path's first pose, degrees (0: level).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    camera_tilt: f64,
     /// Take the log as it is, already in the camera's world frame (origin at the camera, +Y
     /// up, +Z toward the camera: a tracked log), instead of moving it in front of the camera.
     #[arg(long, conflicts_with = "distance")]
@@ -301,6 +314,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         )
         .into());
     }
+    check_tilt(a.camera_tilt)?;
     let log = PoseLog::read_path(&a.log)?;
     let setup = Setup {
         fov_deg: a.fov,
@@ -320,12 +334,13 @@ fn render(a: &RenderArgs) -> Result<()> {
         },
         seed: a.seed,
         rig_box: a.rig.as_ref().map(|_| a.box_size.size()),
+        camera_tilt_deg: a.camera_tilt,
         ..Setup::default()
     };
     let placed = if a.as_is {
         log
     } else {
-        place(&log, setup.distance)
+        place(&log, setup.distance, setup.camera())
     };
     let sc = scene(&setup, Family::Tag36h11, a.tag_id)?;
     let frames = render_video(&setup, &sc, &placed, &a.out)?;
@@ -376,6 +391,17 @@ fn intrinsics(args: &RunArgs, width: usize, height: usize) -> Result<Intrinsics,
     Ok(intrinsics_from_fov(width, height, fov))
 }
 
+/// A camera tilt given on the command line: degrees, between looking straight down and up.
+fn check_tilt(deg: f64) -> Result<(), TrackError> {
+    if deg.abs() < 90.0 {
+        Ok(())
+    } else {
+        Err(TrackError::BadArgument(format!(
+            "--camera-tilt {deg}: how far the camera looks down, degrees (-90 to 90)"
+        )))
+    }
+}
+
 /// `figurine track --video|--camera …`.
 pub fn track(args: &RunArgs) -> Result<()> {
     if !(args.tag_size.is_finite() && args.tag_size > 0.0 && args.tag_size < 1.0) {
@@ -424,6 +450,7 @@ pub fn track(args: &RunArgs) -> Result<()> {
     if let Some(path) = &args.calibration {
         Calibration::read(path)?;
     }
+    check_tilt(args.camera_tilt)?;
     let name = match &source {
         Source::File(p) => p.display().to_string(),
         Source::Camera { device, .. } => device.display().to_string(),
@@ -444,13 +471,15 @@ pub fn track(args: &RunArgs) -> Result<()> {
     let tag_size = rig.tag_size;
     let mut tracker = Tracker::with_rig(detector, rig, k)
         .with_smoothing(!args.raw)
-        .with_exposure(args.exposure_ms / 1000.0);
+        .with_exposure(args.exposure_ms / 1000.0)
+        .with_camera_tilt(args.camera_tilt);
     let mut sink = Sink::open(args.out.as_deref())?;
     let mut overlay_done = args.overlay.is_none();
     let mut frames = 0u64;
     let mut samples = 0u64;
     let mut latency = Vec::new();
     let live = matches!(source, Source::Camera { .. });
+    let mut kept = Vec::new();
     while let Some((t, frame)) = reader.next_frame()? {
         let start = std::time::Instant::now();
         let result = tracker.frame(t, &frame);
@@ -459,6 +488,9 @@ pub fn track(args: &RunArgs) -> Result<()> {
         if let Some(s) = &result.sample {
             sink.push(s)?;
             samples += 1;
+            if args.level {
+                kept.push(*s);
+            }
         }
         if !overlay_done {
             if let (Some(path), false) = (&args.overlay, result.detections.is_empty()) {
@@ -495,6 +527,25 @@ pub fn track(args: &RunArgs) -> Result<()> {
         "{name}: {samples} samples from {frames} frames ({:.1} % lost), {median_ms:.1} ms per frame",
         100.0 * (frames - samples) as f64 / frames.max(1) as f64
     );
+    if args.level {
+        let level = super::level::measure(&kept)?;
+        println!(
+            "the camera looks down {:.1}° (rolled {:.1}°; from {} still samples, up axes \
+             within {:.1}° RMS): track with --camera-tilt {:.1}",
+            level.tilt_deg,
+            level.roll_deg + 0.0,
+            level.still,
+            level.spread_deg,
+            level.tilt_deg
+        );
+        if level.roll_deg.abs() > 3.0 {
+            eprintln!(
+                "{name}: the camera is rolled {:.1}°, which --camera-tilt does not undo: \
+                 turn it level sideways",
+                level.roll_deg
+            );
+        }
+    }
     Ok(())
 }
 

@@ -10,7 +10,7 @@ use glam::{DQuat, DVec3};
 
 use super::body::Body;
 use super::detect::{tag_pattern, Detector, DetectorSettings, Family};
-use super::pose::{angle_between_deg, intrinsics_from_fov, project, FLIP_YZ};
+use super::pose::{angle_between_deg, camera_tilt, intrinsics_from_fov, project, FLIP_YZ};
 use super::render::{Faults, Scene};
 use super::rig::{BoxSize, Rig};
 use super::tracker::{track_reader, Tracker};
@@ -40,6 +40,16 @@ pub struct Setup {
     /// A box rig of four tags (ids from the tag id on: front, left, back, right) instead of
     /// one tag on the chest.
     pub rig_box: Option<BoxSize>,
+    /// How far the camera looks down, degrees (0: level; a laptop's webcam looking at a toy
+    /// on the desk, 20–40).
+    pub camera_tilt_deg: f64,
+}
+
+impl Setup {
+    /// The camera's frame in the world ([`camera_tilt`]).
+    pub fn camera(&self) -> DQuat {
+        camera_tilt(self.camera_tilt_deg)
+    }
 }
 
 impl Default for Setup {
@@ -54,6 +64,7 @@ impl Default for Setup {
             faults: Faults::default(),
             seed: 0,
             rig_box: None,
+            camera_tilt_deg: 0.0,
         }
     }
 }
@@ -63,9 +74,10 @@ pub fn quat(s: &PoseSample) -> DQuat {
     DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize()
 }
 
-/// Moves a doodle in front of the camera: its first pose `distance` metres straight ahead,
-/// turned about the vertical so that its first front faces the camera (the tag in view).
-pub fn place(log: &PoseLog, distance: f64) -> PoseLog {
+/// Moves a doodle in front of the camera (its frame in the world `camera`,
+/// [`Setup::camera`]): its first pose `distance` metres along the line of sight, turned about
+/// the vertical so that its first front faces the camera (the tag in view).
+pub fn place(log: &PoseLog, distance: f64, camera: DQuat) -> PoseLog {
     let Some(first) = log.samples.first() else {
         return log.clone();
     };
@@ -73,7 +85,7 @@ pub fn place(log: &PoseLog, distance: f64) -> PoseLog {
     let yaw = front.x.atan2(front.z);
     let turn = DQuat::from_rotation_y(-yaw);
     let p0 = DVec3::from_array(first.pos);
-    let target = DVec3::new(0.0, 0.0, -distance);
+    let target = camera * DVec3::new(0.0, 0.0, -distance);
     PoseLog {
         samples: log
             .samples
@@ -151,7 +163,7 @@ pub fn facing_deg(pose: &PoseSample) -> f64 {
 /// [`MAX_VIEW_DEG`], and whole inside the picture (a tag cut by the frame's edge cannot be
 /// read, however well it faces the camera).
 pub fn tags_in_sight(scene: &Scene, pose: &PoseSample) -> usize {
-    let (pos, q) = (DVec3::from_array(pose.pos), quat(pose));
+    let (pos, q) = scene.in_camera(pose);
     let body = &scene.body;
     let half = body.tag_size / 2.0;
     let inside = |p: DVec3| {
@@ -205,6 +217,7 @@ pub fn scene(setup: &Setup, family: Family, id: u32) -> Result<Scene, TrackError
         body,
         faults: setup.faults,
         seed: setup.seed,
+        camera: setup.camera(),
     })
 }
 
@@ -259,6 +272,9 @@ pub struct Tracking {
     /// The exposure the tracker assumes, seconds ([`Tracker::with_exposure`]): its guess, not
     /// necessarily the exposure the video was rendered with.
     pub exposure_s: f64,
+    /// How far the tracker is told the camera looks down, degrees
+    /// ([`Tracker::with_camera_tilt`]): its guess, not necessarily the video's.
+    pub camera_tilt_deg: f64,
 }
 
 impl Default for Tracking {
@@ -267,6 +283,7 @@ impl Default for Tracking {
             smooth: true,
             region_search: true,
             exposure_s: super::tracker::DEFAULT_EXPOSURE_S,
+            camera_tilt_deg: 0.0,
         }
     }
 }
@@ -285,7 +302,8 @@ pub fn track_video(
     let mut tracker = Tracker::with_rig(detector, rig(setup, family, id)?, k)
         .with_smoothing(how.smooth)
         .with_region_search(how.region_search)
-        .with_exposure(how.exposure_s);
+        .with_exposure(how.exposure_s)
+        .with_camera_tilt(how.camera_tilt_deg);
     track_reader(&mut reader, &mut tracker, |_| Ok(()))
 }
 
@@ -493,13 +511,33 @@ mod tests {
 
     #[test]
     fn placing_puts_the_first_pose_ahead_facing_the_camera() {
-        let placed = place(&log(4), 0.8);
+        let placed = place(&log(4), 0.8, DQuat::IDENTITY);
         let first = &placed.samples[0];
         assert!((DVec3::from_array(first.pos) - DVec3::new(0.0, 0.0, -0.8)).length() < 1e-9);
         assert!((quat(first) * DVec3::Z - DVec3::Z).length() < 1e-9);
         // The path keeps its shape: consecutive steps are still 1 m long.
         let step = DVec3::from_array(placed.samples[1].pos) - DVec3::from_array(first.pos);
         assert!((step.length() - 1.0).abs() < 1e-9);
+        // A camera looking down 30°: 0.8 m along its line of sight, 0.4 m below it, upright
+        // in the world and facing the camera across the floor.
+        let setup = Setup {
+            camera_tilt_deg: 30.0,
+            ..Setup::default()
+        };
+        let placed = place(&log(4), 0.8, setup.camera());
+        let first = &placed.samples[0];
+        let p = DVec3::from_array(first.pos);
+        assert!(
+            (p.y + 0.4).abs() < 1e-9 && p.z < -0.69 && p.x.abs() < 1e-9,
+            "{p}"
+        );
+        assert!((quat(first) * DVec3::Z - DVec3::Z).length() < 1e-9);
+        // In sight, the tag seen from 30° above.
+        let sc = scene(&setup, Family::Tag36h11, 0).unwrap();
+        assert_eq!(tags_in_sight(&sc, first), 1);
+        let (in_cam, q) = sc.in_camera(first);
+        assert!((in_cam - DVec3::new(0.0, 0.0, -0.8)).length() < 1e-9);
+        assert!(((q * DVec3::Z).angle_between(DVec3::Z).to_degrees() - 30.0).abs() < 1e-9);
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! frame when it is not there; [`pnp`] solves its pose from them (homography, then
 //! Levenberg–Marquardt on the four corners); [`pose`] turns that into the pose log's frames;
 //! [`tracker`] keeps one tag id and writes a sample per frame where it was seen — a lost tag
-//! gives no sample, never a made-up pose. [`render`] draws test videos of the tag on
+//! gives no sample, never a made-up pose; a camera that looks down has its tilt undone
+//! ([`pose::camera_tilt`], measured by [`level`]). [`render`] draws test videos of the tag on
 //! a moving figurine and [`eval`] compares what was tracked with the truth.
 
 pub mod bench;
@@ -16,6 +17,7 @@ pub mod deblur;
 pub mod detect;
 pub mod eval;
 pub mod fuse;
+pub mod level;
 pub mod mirror;
 pub mod pnp;
 pub mod pose;

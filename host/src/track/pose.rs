@@ -142,6 +142,13 @@ pub fn camera_pose(pos: DVec3, q: DQuat) -> (DMat3, DVec3) {
     (FLIP_YZ * r_wf * FLIP_YZ, FLIP_YZ * pos)
 }
 
+/// The rotation from the camera's frame (+X right, +Y up, +Z toward the viewer, as if it
+/// were level) to the world (+Y up) of a camera that looks down `deg` degrees (negative: up):
+/// a pose the camera measures is `camera_tilt(deg) * pose` in the world.
+pub fn camera_tilt(deg: f64) -> DQuat {
+    DQuat::from_rotation_x(-deg.to_radians())
+}
+
 /// Projects a camera-frame point to pixels; `None` behind or too near the camera.
 pub fn project(k: &Intrinsics, p: DVec3) -> Option<[f64; 2]> {
     (p.z > 1e-3).then(|| [k.cx + k.fx * p.x / p.z, k.cy + k.fy * p.y / p.z])

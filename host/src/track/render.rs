@@ -63,6 +63,8 @@ pub struct Scene {
     pub faults: Faults,
     /// Seed of the noise, light and occlusion.
     pub seed: u64,
+    /// The camera's frame in the world ([`super::pose::camera_tilt`]; identity: level).
+    pub camera: DQuat,
 }
 
 /// One rendered frame and what it shows.
@@ -123,11 +125,20 @@ impl PlaneView {
 }
 
 impl Scene {
+    /// A world pose's position and orientation in the camera's frame.
+    pub fn in_camera(&self, pose: &PoseSample) -> (DVec3, DQuat) {
+        let to_camera = self.camera.inverse();
+        let q = DQuat::from_xyzw(pose.quat[1], pose.quat[2], pose.quat[3], pose.quat[0]);
+        (
+            to_camera * DVec3::from_array(pose.pos),
+            (to_camera * q).normalize(),
+        )
+    }
+
     /// The views of the body's panels at the pose (the backs of a closed box's faces left
     /// out).
     fn views(&self, pose: &PoseSample) -> Vec<PlaneView> {
-        let pos = DVec3::from_array(pose.pos);
-        let q = DQuat::from_xyzw(pose.quat[1], pose.quat[2], pose.quat[3], pose.quat[0]);
+        let (pos, q) = self.in_camera(pose);
         self.body
             .panels
             .iter()
@@ -315,10 +326,7 @@ impl Scene {
         for i in 0..views.len() {
             let dt = self.faults.exposure_s * ((i as f64 + 0.5) / views.len() as f64 - 0.5);
             let Some(p) = pose_at(t + dt) else { continue };
-            let (pos, q) = (
-                DVec3::from_array(p.pos),
-                DQuat::from_xyzw(p.quat[1], p.quat[2], p.quat[3], p.quat[0]),
-            );
+            let (pos, q) = self.in_camera(&p);
             for panel in &self.body.panels {
                 let (pp, pq) = self.body.panel_pose(panel, pos, q);
                 let (r, c) = camera_pose(pp, pq);
@@ -481,6 +489,7 @@ pub(crate) mod tests {
             body: Body::chest(tag_pattern(Family::Tag36h11, 0).unwrap(), 0.04),
             faults,
             seed,
+            camera: DQuat::IDENTITY,
         }
     }
 

@@ -78,7 +78,7 @@ pub fn run_still(
     if let Err(e) = spec.validate() {
         anyhow::bail!("--rest-seconds: {e}");
     }
-    let placed = place(&rest_log(seed, &spec).log, setup.distance);
+    let placed = place(&rest_log(seed, &spec).log, setup.distance, setup.camera());
     let sc = scene(setup, Family::Tag36h11, 0)?;
     let video = dir.join(format!("still-{seed}.mp4"));
     let truths: Vec<FrameTruth> = match kept_truths(reuse, &video, setup, &sc) {

@@ -76,6 +76,8 @@ pub struct Tracker {
     search_near: bool,
     /// The camera's exposure, seconds, for predicting motion blur (0: no blur retry).
     exposure_s: f64,
+    /// The camera's frame in the world ([`super::pose::camera_tilt`]; identity: level).
+    camera: DQuat,
 }
 
 /// What one frame gave.
@@ -113,7 +115,19 @@ impl Tracker {
             seen: None,
             search_near: true,
             exposure_s: DEFAULT_EXPOSURE_S,
+            camera: DQuat::IDENTITY,
         }
+    }
+
+    /// The camera looks down `deg` degrees (0 unless set: level): every pose is turned from
+    /// the camera's frame into the world's, whose +Y is up, before it is reported.
+    pub fn with_camera_tilt(mut self, deg: f64) -> Self {
+        self.camera = if deg.is_finite() {
+            super::pose::camera_tilt(deg)
+        } else {
+            DQuat::IDENTITY
+        };
+        self
     }
 
     /// The camera's exposure (seconds; [`DEFAULT_EXPOSURE_S`] unless set), from which a moving
@@ -193,6 +207,7 @@ impl Tracker {
             if let Some(f) = &mut self.smooth {
                 q = f.push(t, q);
             }
+            let (p, mut q) = (self.camera * p, (self.camera * q).normalize());
             if let Some(last) = self.last {
                 if q.dot(last) < 0.0 {
                     q = -q;

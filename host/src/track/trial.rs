@@ -124,8 +124,13 @@ fn truths_head(setup: &Setup) -> String {
             .map_or(String::new(), |h| format!(", top tag {h} m up"));
         format!(", box {} × {} m{top}", b.width, b.depth)
     });
+    let tilt = if setup.camera_tilt_deg == 0.0 {
+        String::new()
+    } else {
+        format!(", camera looking {}° down", setup.camera_tilt_deg)
+    };
     format!(
-        "# tag {} m at {} m, seed {}, {} fps{rig}",
+        "# tag {} m at {} m, seed {}, {} fps{rig}{tilt}",
         setup.tag_size, setup.distance, setup.seed, setup.fps
     )
 }
