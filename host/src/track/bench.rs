@@ -381,7 +381,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ("--camera-tilt", args.camera_tilt),
         ("--track-tilt", args.track_tilt.unwrap_or(0.0)),
     ] {
-        if !(deg.abs() < 90.0) {
+        if deg.is_nan() || deg.abs() >= 90.0 {
             anyhow::bail!("{flag} {deg}: how far the camera looks down, degrees (-90 to 90)");
         }
     }
