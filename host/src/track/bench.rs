@@ -304,6 +304,18 @@ pub fn report(runs: &[GestureRun]) -> String {
         share(gaps_only),
         share(error_only)
     );
+    // Against what was played: the tracked log may read the action where the truth misreads
+    // it, and the other way round.
+    let played = |r: &&GestureRun, read: &[String]| read == [r.action.name()];
+    let truth_played = runs.iter().filter(|r| played(r, &r.truth_actions)).count();
+    let tracked_played = runs.iter().filter(|r| played(r, &r.tracked_actions)).count();
+    let _ = writeln!(
+        out,
+        "  read as the action played, alone: from the truth {truth_played} ({:.1} %), from the \
+         tracked log {tracked_played} ({:.1} %)",
+        share(truth_played),
+        share(tracked_played)
+    );
     // A reading that already needed edits from the truth lies near its pattern's edge, where
     // a few millimetres of tracking error tip it: the share that agrees, by those edits.
     let _ = write!(out, "  by the edits the true log's reading needed:");
