@@ -308,7 +308,10 @@ pub fn report(runs: &[GestureRun]) -> String {
     // it, and the other way round.
     let played = |r: &&GestureRun, read: &[String]| read == [r.action.name()];
     let truth_played = runs.iter().filter(|r| played(r, &r.truth_actions)).count();
-    let tracked_played = runs.iter().filter(|r| played(r, &r.tracked_actions)).count();
+    let tracked_played = runs
+        .iter()
+        .filter(|r| played(r, &r.tracked_actions))
+        .count();
     let _ = writeln!(
         out,
         "  read as the action played, alone: from the truth {truth_played} ({:.1} %), from the \
