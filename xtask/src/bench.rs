@@ -79,6 +79,23 @@ pub fn bench() -> Result<()> {
          figurine track bench",
     );
     figurine(&["track", "bench"])?;
+    step(
+        "webcam tracker, the box rig with its top seen from a camera looking down 25 degrees \
+         (told the tilt): figurine track bench --rig box --box-top 0.0925 --camera-tilt 25 \
+         --rest-seconds 0",
+    );
+    figurine(&[
+        "track",
+        "bench",
+        "--rig",
+        "box",
+        "--box-top",
+        "0.0925",
+        "--camera-tilt",
+        "25",
+        "--rest-seconds",
+        "0",
+    ])?;
 
     step("firmware: sizes, instructions per sample, latency, sustained rate");
     if !crate::util::have("defmt-print") {
