@@ -60,7 +60,7 @@ fn a_box_rig_is_tracked_at_every_heading_of_a_full_turn() {
         let video = dir.join(format!("spin-{}.mp4", rig_box.is_some()));
         let truths = render_video(&setup, &sc, &spin(), &video).unwrap();
         let run = track_video(&setup, Family::Tag36h11, 0, &video, Tracking::default()).unwrap();
-        let frames = compare(&truths, &run.log);
+        let frames = compare(&truths, &run.log, setup.camera());
         let all = summarize(&frames);
         lost.push((all.lost, longest_gap(&frames), all.frames));
         if rig_box.is_some() {
@@ -146,7 +146,7 @@ fn a_fast_turn_stays_within_half_the_mirror_angle_at_every_frame() {
     let video = dir.join("turn.mp4");
     let truths = render_video(&setup, &sc, &turn, &video).unwrap();
     let run = track_video(&setup, Family::Tag36h11, 0, &video, Tracking::default()).unwrap();
-    let frames = compare(&truths, &run.log);
+    let frames = compare(&truths, &run.log, setup.camera());
     assert!(summarize(&frames).lost <= 2, "{:?}", summarize(&frames));
     // Every frame within half the mirror's 22° of the truth.
     let worst = frames

@@ -138,7 +138,7 @@ pub fn run_gesture(
         }
     };
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
-    let frames = compare(&truths, &run.log);
+    let frames = compare(&truths, &run.log, setup.camera());
     let truth = truth_log(&truths);
     let (truth_actions, truth_edits) = reading_of(&truth)?;
     let tracked_actions = actions_of(&run.log)?;

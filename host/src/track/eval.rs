@@ -314,14 +314,17 @@ pub struct FrameError {
     pub truth: FrameTruth,
     /// Position error, mm, and orientation error, degrees; `None` for a lost frame.
     pub error: Option<(f64, f64)>,
-    /// Error vector tracked − true, metres, in world axes (x across, y up, z depth).
+    /// Error vector tracked − true, metres, in the camera's axes (x across, y up the picture,
+    /// z depth).
     pub delta: Option<DVec3>,
     /// The tracked sample.
     pub tracked: Option<PoseSample>,
 }
 
-/// Pairs each rendered frame with the sample tracked at its time.
-pub fn compare(truth: &[FrameTruth], tracked: &PoseLog) -> Vec<FrameError> {
+/// Pairs each rendered frame with the sample tracked at its time (both in the world, the
+/// camera's frame in it `camera`: [`Setup::camera`]).
+pub fn compare(truth: &[FrameTruth], tracked: &PoseLog, camera: DQuat) -> Vec<FrameError> {
+    let to_camera = camera.inverse();
     truth
         .iter()
         .map(|f| {
@@ -330,7 +333,8 @@ pub fn compare(truth: &[FrameTruth], tracked: &PoseLog) -> Vec<FrameError> {
                 .iter()
                 .find(|s| (s.t - f.t).abs() < 1e-6)
                 .copied();
-            let delta = found.map(|s| DVec3::from_array(s.pos) - DVec3::from_array(f.pose.pos));
+            let delta = found
+                .map(|s| to_camera * (DVec3::from_array(s.pos) - DVec3::from_array(f.pose.pos)));
             let error = found.map(|s| {
                 (
                     (DVec3::from_array(s.pos) - DVec3::from_array(f.pose.pos)).length() * 1000.0,

@@ -92,7 +92,7 @@ pub fn run_still(
         }
     };
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
-    let frames = compare(&truths, &run.log);
+    let frames = compare(&truths, &run.log, setup.camera());
     let truth = truth_log(&truths);
     // The truth's turn over the frames the tracker kept, so both jitters span the same gaps.
     let kept: Vec<PoseSample> = frames
