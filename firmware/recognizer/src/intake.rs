@@ -23,6 +23,9 @@ pub const TICK_S: f32 = 0.01;
 pub const MAX_GAP_US: u64 = 250_000;
 /// A position step larger than this (m) between accepted samples is a glitch, skipped.
 pub const MAX_STEP_M: f32 = 0.5;
+/// A step at least this many times as long as the one before it lost samples in between:
+/// only across such a gap does a turn that was speeding up carry on speeding up.
+pub const LOST_STEP_RATIO: u64 = 2;
 /// Speed (m/s) above which a position step is a glitch (a toy does not move at 25 m/s).
 pub const MAX_SPEED_M_S: f32 = 25.0;
 /// Absolute coordinate bound (m); larger values are treated as garbage.
@@ -119,6 +122,9 @@ pub struct Intake {
     /// step `q_prev⁻¹ q` over its time; its axis is the same before and after the step): what
     /// carries a spin across frames the tracker lost.
     raw_rate: [f32; 3],
+    /// How fast the last step's turn rate grew on the one before, rad/s²: a spin speeding up
+    /// as the tracker lost it turns further across the gap than its first frames' rate says.
+    raw_gain: f32,
     next_tick_us: u64,
 }
 
@@ -145,6 +151,7 @@ impl Intake {
             cur: None,
             raw_quat: [1.0, 0.0, 0.0, 0.0],
             raw_rate: [0.0; 3],
+            raw_gain: 0.0,
             next_tick_us: 0,
         }
     }
@@ -203,7 +210,8 @@ impl Intake {
             self.counters.jumps = self.counters.jumps.saturating_add(1);
             return Accept::Rejected;
         }
-        q = self.continue_turn(q, dt_s);
+        let lost = matches!(self.prev, Some((t0, _, _)) if dt_us >= LOST_STEP_RATIO.saturating_mul(t_prev.saturating_sub(t0)));
+        q = self.continue_turn(q, dt_s, lost);
         // First-order low-pass, exact for any sample spacing up to the discretisation
         // (dt / (τ + dt)): slow trackers pass nearly untouched, fast ones are averaged.
         let a = dt_us as f32 / (ANTI_ALIAS_TAU_US + dt_us) as f32;
@@ -235,7 +243,7 @@ impl Intake {
     /// past the half turn the other way: of the two rotations that end at `q`, the one nearer
     /// the rate the figurine already had. Between samples of a steady tracker the two agree;
     /// across frames lost mid-spin (≈ 1 rad a frame at 30 Hz) the short way runs backwards.
-    fn continue_turn(&mut self, q: [f32; 4], dt_s: f32) -> [f32; 4] {
+    fn continue_turn(&mut self, q: [f32; 4], dt_s: f32, lost: bool) -> [f32; 4] {
         let mut q = q;
         if fmath::qdot(q, self.raw_quat) < 0.0 {
             q = [-q[0], -q[1], -q[2], -q[3]];
@@ -244,15 +252,24 @@ impl Intake {
         let v = [step[1], step[2], step[3]];
         let s = fmath::norm3(v);
         self.raw_quat = q;
+        let was = fmath::norm3(self.raw_rate);
         if s <= 0.0 {
             self.raw_rate = [0.0; 3];
+            self.raw_gain = -was / dt_s;
             return q;
         }
         let axis = [v[0] / s, v[1] / s, v[2] / s];
         let short = 2.0 * fmath::atan2(s, step[0]);
-        // Rate of the last step along this one's axis, carried over this step (radians):
-        // below −(π − short) the rotation the long way round is the nearer one.
-        let carried = fmath::dot3(self.raw_rate, axis) * dt_s;
+        // Rate of the last step along this one's axis, carried over this step (radians),
+        // still speeding up if it was: below −(π − short) the rotation the long way round is
+        // the nearer one.
+        let along = fmath::dot3(self.raw_rate, axis);
+        let gain = if lost && was > 0.0 {
+            0.5 * fmath::max(self.raw_gain, 0.0) * (along / was) * dt_s * dt_s
+        } else {
+            0.0
+        };
+        let carried = along * dt_s + gain;
         let angle = if carried < short - core::f32::consts::PI {
             q = [-q[0], -q[1], -q[2], -q[3]];
             self.raw_quat = q;
@@ -262,6 +279,7 @@ impl Intake {
         };
         let rate = angle / dt_s;
         self.raw_rate = [axis[0] * rate, axis[1] * rate, axis[2] * rate];
+        self.raw_gain = (fmath::abs(rate) - was) / dt_s;
         q
     }
 
@@ -272,6 +290,7 @@ impl Intake {
         self.cur = Some((s.t_us, [0.0; 3], q, s.seq));
         self.raw_quat = q;
         self.raw_rate = [0.0; 3];
+        self.raw_gain = 0.0;
         self.next_tick_us = s.t_us;
     }
 
@@ -534,6 +553,38 @@ mod tests {
         let total: f32 = steps.iter().sum();
         // The low-pass trails the last sample by a few hundredths of a radian.
         assert!((total - 13.0).abs() < 0.2, "turned {total} rad of 13");
+    }
+
+    #[test]
+    fn a_spin_speeding_up_as_the_tracker_lost_it_keeps_turning_the_long_way() {
+        // A spin starting (0.05, then 0.25 rad a frame at 30 Hz) as the tracker loses it for
+        // four frames: the sample after the gap is 5.5 rad on, 0.78 rad back the short way.
+        // The rate before the gap alone carries 5 × 0.25 rad, nearer the short way back;
+        // still speeding up (180 rad/s²), it carries 3.75 rad, nearer the long way on.
+        let yaw = [0.0, 0.0, 0.0, 0.05, 0.3, 5.8, 6.3, 6.3];
+        let times = [0, 1, 2, 3, 4, 9, 10, 11];
+        let samples: heapless::Vec<(u64, f32), 8> = times
+            .iter()
+            .zip(yaw)
+            .map(|(&k, y)| (k * 33_333, y))
+            .collect();
+        let steps = yaw_steps(&yaw_ticks(&samples));
+        assert!(
+            steps.iter().all(|&a| a >= 0.0),
+            "a tick turned back: {steps:?}"
+        );
+        let total: f32 = steps.iter().sum();
+        assert!((total - 6.3).abs() < 0.2, "turned {total} rad of 6.3");
+        // The same start with no frame lost: 2.84 rad back is nearer the 0.25 rad a frame had
+        // than 3.44 on (speeding on, it would not be).
+        let yaw = [0.0, 0.0, 0.0, 0.05, 0.3, 0.3 - 2.84];
+        let samples: heapless::Vec<(u64, f32), 8> = yaw
+            .iter()
+            .enumerate()
+            .map(|(k, &y)| (k as u64 * 33_333, y))
+            .collect();
+        let total: f32 = yaw_steps(&yaw_ticks(&samples)).iter().sum();
+        assert!(total < 0.0, "turned {total} rad");
     }
 
     #[test]
