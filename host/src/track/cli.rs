@@ -87,13 +87,13 @@ pub struct RunArgs {
     #[arg(long, default_value_t = DEFAULT_EXPOSURE_S * 1000.0)]
     pub exposure_ms: f64,
     /// How far the camera looks down, degrees (0: level): the log's world keeps +Y up all the
-    /// same. A laptop's webcam looking at a toy on the desk looks down 20–40°; measured from
-    /// the toy standing upright in view by `figurine track level`.
+    /// same. A laptop's webcam looking at a toy on the desk looks down 20–40°; `--level`
+    /// measures it from the toy standing upright in view.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub camera_tilt: f64,
-    /// Measure how far the camera looks down, from a video (or camera) of the figurine
-    /// standing upright and still in view for a second or two, and print it for
-    /// `--camera-tilt` ([`super::level`]).
+    /// Measure how far the camera looks down, from a video of the figurine standing upright
+    /// and still in view for a second or two (from a camera: its first few seconds, then
+    /// stop), and print it for `--camera-tilt` ([`super::level`]).
     #[arg(long, conflicts_with = "camera_tilt")]
     pub level: bool,
     /// Track a rig of tags around the figurine instead of one on its chest: `box` (tags
@@ -481,6 +481,15 @@ pub fn track(args: &RunArgs) -> Result<()> {
     let live = matches!(source, Source::Camera { .. });
     let mut kept = Vec::new();
     while let Some((t, frame)) = reader.next_frame()? {
+        // A live camera runs until stopped: the level is measured over its first seconds.
+        if args.level
+            && live
+            && kept
+                .first()
+                .is_some_and(|f: &PoseSample| t - f.t > super::level::LIVE_S)
+        {
+            break;
+        }
         let start = std::time::Instant::now();
         let result = tracker.frame(t, &frame);
         latency.push(start.elapsed().as_secs_f64());

@@ -19,6 +19,8 @@ use glam::{DQuat, DVec3};
 use super::TrackError;
 use crate::poselog::PoseSample;
 
+/// Seconds of samples a live camera's level is measured over (from its first sample on).
+pub const LIVE_S: f64 = 4.0;
 /// Half-width of the window a still sample's neighbours lie in, seconds.
 pub const STILL_WINDOW_S: f64 = 0.25;
 /// Farthest a still sample's neighbours lie from it, millimetres.
