@@ -210,7 +210,9 @@ impl Intake {
             self.counters.jumps = self.counters.jumps.saturating_add(1);
             return Accept::Rejected;
         }
-        let lost = matches!(self.prev, Some((t0, _, _)) if dt_us >= LOST_STEP_RATIO.saturating_mul(t_prev.saturating_sub(t0)));
+        // Samples were lost when this step is much longer than the one before it.
+        let last_us = self.prev.map_or(0, |(t0, _, _)| t_prev.saturating_sub(t0));
+        let lost = last_us > 0 && dt_us >= LOST_STEP_RATIO.saturating_mul(last_us);
         q = self.continue_turn(q, dt_s, lost);
         // First-order low-pass, exact for any sample spacing up to the discretisation
         // (dt / (τ + dt)): slow trackers pass nearly untouched, fast ones are averaged.
