@@ -542,7 +542,7 @@ pub fn track(args: &RunArgs) -> Result<()> {
             "the camera looks down {:.1}° (rolled {:.1}°; from {} still samples, up axes \
              within {:.1}° RMS): track with --camera-tilt {:.1}",
             level.tilt_deg,
-            level.roll_deg + 0.0,
+            (level.roll_deg * 10.0).round() / 10.0 + 0.0,
             level.still,
             level.spread_deg,
             level.tilt_deg

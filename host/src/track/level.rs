@@ -14,8 +14,10 @@
 //! | up | the mean of the still samples' up axes, in the camera's frame |
 //! | tilt, roll | the up's lean toward the camera (the tilt) and sideways (the roll, reported: `--camera-tilt` corrects the tilt only) |
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 
+use super::eval::quat;
+use super::pose::angle_between_deg;
 use super::TrackError;
 use crate::poselog::PoseSample;
 
@@ -49,18 +51,18 @@ pub struct Level {
 
 /// The figurine's up axis in the camera's frame at `s`.
 fn up_of(s: &PoseSample) -> DVec3 {
-    let q = DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize();
-    q * DVec3::Y
+    quat(s) * DVec3::Y
 }
 
-/// Whether every sample within [`STILL_WINDOW_S`] of `samples[i]` lies within [`STILL_MM`]
-/// and [`STILL_DEG`] of it, and the window is covered on both sides.
+/// Whether every sample within [`STILL_WINDOW_S`] of `samples[i]` (in time order, as the
+/// tracker writes them) lies within [`STILL_MM`] and [`STILL_DEG`] of it, and the window is
+/// covered on both sides.
 fn is_still(samples: &[PoseSample], i: usize) -> bool {
     let s = &samples[i];
-    let p = DVec3::from_array(s.pos);
-    let q = DQuat::from_xyzw(s.quat[1], s.quat[2], s.quat[3], s.quat[0]).normalize();
-    let near = |o: &&PoseSample| (o.t - s.t).abs() <= STILL_WINDOW_S;
-    let window: Vec<&PoseSample> = samples.iter().filter(near).collect();
+    let (p, q) = (DVec3::from_array(s.pos), quat(s));
+    let from = samples.partition_point(|o| o.t < s.t - STILL_WINDOW_S);
+    let to = samples.partition_point(|o| o.t <= s.t + STILL_WINDOW_S);
+    let window = &samples[from..to.max(from)];
     let covered = window
         .first()
         .is_some_and(|a| a.t <= s.t - 0.8 * STILL_WINDOW_S)
@@ -69,9 +71,8 @@ fn is_still(samples: &[PoseSample], i: usize) -> bool {
             .is_some_and(|b| b.t >= s.t + 0.8 * STILL_WINDOW_S);
     covered
         && window.iter().all(|o| {
-            let qo = DQuat::from_xyzw(o.quat[1], o.quat[2], o.quat[3], o.quat[0]).normalize();
             (DVec3::from_array(o.pos) - p).length() * 1000.0 <= STILL_MM
-                && super::pose::angle_between_deg(q, qo) <= STILL_DEG
+                && angle_between_deg(q, quat(o)) <= STILL_DEG
         })
 }
 
@@ -116,6 +117,7 @@ pub fn measure(samples: &[PoseSample]) -> Result<Level, TrackError> {
 mod tests {
     use super::*;
     use crate::track::pose::camera_tilt;
+    use glam::DQuat;
 
     /// `n` samples at 30 fps of a figurine at `pos` turned `q` (world), seen by a camera
     /// that looks down `tilt` degrees, in the camera's frame; the first `moving` of them
