@@ -64,11 +64,11 @@ fn learn_then_simulate_a_sequence() {
         let files = csvs(&ex);
         args.extend(files.iter().map(String::as_str));
         let out = figurine(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        // Each example is read back through the device with the library as written.
+        let back = format!("read back as `{action}`\n");
+        assert_eq!(err.matches(&back).count(), files.len(), "{err}");
     }
     let text = std::fs::read_to_string(&lib).unwrap();
     for key in [
@@ -87,6 +87,11 @@ fn learn_then_simulate_a_sequence() {
     let out = figurine(&args);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("warning") && err.contains("`jump`"), "{err}");
+    // … and its examples read back as the action learnt first, which the user is told.
+    assert!(
+        err.contains("read back as `jump` — not as one `hop`"),
+        "{err}"
+    );
 
     let log = d.join("seq.csv");
     let labels = d.join("seq.json");

@@ -7,7 +7,7 @@
 //! | 3 | each run becomes a pattern symbol: the stroke it meant, its wobbles written as such | [`super::intent`] |
 //! | 4 | the mandatory runs are aligned into columns, the optional ones go between them | [`super::columns`] |
 //! | 5 | the pattern accepts the action done to either side | [`super::sides`] |
-//! | 6 | every example is checked to be accepted exactly; the edit bound defaults to about one per three tokens of the shortest match | [`learn_action`] |
+//! | 6 | the edit bound defaults to the most the device allows (one less than the shortest match, at most `MAX_EDITS`); each example is checked against the pattern whole, and once the library is written, read back through the device: what a user acts on | [`learn_action`], [`read_back`] |
 //! | 7 | a pattern that accepts another action's example exactly is narrowed until it does not; when it cannot be without losing its own examples, the other action is made as tolerant of the shared strokes' rotations | [`super::separate`] |
 //!
 //! Besides its pattern, an action keeps what its examples say of how it moves: its motion
@@ -334,7 +334,7 @@ pub fn run(args: &LearnArgs) -> Result<()> {
             p.display(),
             match ok {
                 Some(d) => format!("matched, {} edits", f32::from(d) / 2.0),
-                None => "NOT matched".into(),
+                None => "not matched whole".into(),
             }
         );
     }
@@ -353,7 +353,50 @@ pub fn run(args: &LearnArgs) -> Result<()> {
         eprintln!("{step}");
     }
     lib.write(&args.library)?;
+    for line in read_back(&mut lib, &args.name, &args.examples, &logs)? {
+        eprintln!("{line}");
+    }
     Ok(())
+}
+
+/// What the device makes of each example log with library `lib` (as written), a line each:
+/// the check a user can act on. A pattern may not accept a whole example, yet the device
+/// reads it right; and an example it reads as something else, or as two actions, or as
+/// nothing, is one to play again (or to add examples beside).
+pub fn read_back(
+    lib: &mut LibraryFile,
+    name: &str,
+    paths: &[PathBuf],
+    logs: &[PoseLog],
+) -> Result<Vec<String>> {
+    let blob = lib.blob()?;
+    let names = lib.names();
+    let mut lines = Vec::new();
+    for (p, log) in paths.iter().zip(logs) {
+        let sim = super::simulate::simulate_log(log, &names, &blob, None)?;
+        let read: Vec<String> = sim
+            .records
+            .iter()
+            .map(|r| format!("`{}`", r.action))
+            .collect();
+        let ok = matches!(sim.records.as_slice(), [r] if r.action == name);
+        lines.push(format!(
+            "  {}: read back as {}{}",
+            p.display(),
+            if read.is_empty() {
+                "nothing".to_string()
+            } else {
+                read.join(", ")
+            },
+            if ok {
+                ""
+            } else {
+                " — not as one `NAME`: play it again, or add examples"
+            }
+            .replace("NAME", name)
+        ));
+    }
+    Ok(lines)
 }
 
 #[cfg(test)]
