@@ -379,22 +379,16 @@ pub fn read_back(
             .iter()
             .map(|r| format!("`{}`", r.action))
             .collect();
-        let ok = matches!(sim.records.as_slice(), [r] if r.action == name);
-        lines.push(format!(
-            "  {}: read back as {}{}",
-            p.display(),
-            if read.is_empty() {
-                "nothing".to_string()
-            } else {
-                read.join(", ")
-            },
-            if ok {
-                ""
-            } else {
-                " — not as one `NAME`: play it again, or add examples"
-            }
-            .replace("NAME", name)
-        ));
+        let read = if read.is_empty() {
+            "nothing".to_string()
+        } else {
+            read.join(", ")
+        };
+        let verdict = match sim.records.as_slice() {
+            [r] if r.action == name => String::new(),
+            _ => format!(" — not as one `{name}`: play it again, or add examples"),
+        };
+        lines.push(format!("  {}: read back as {read}{verdict}", p.display()));
     }
     Ok(lines)
 }
