@@ -105,8 +105,10 @@ pub struct Recognizer<'lib> {
     /// The pending candidate already reported while it may still change, with the held event
     /// as it was before the report and whether the report continued it.
     provisional: Option<(Candidate, Option<Held>, bool)>,
-    /// The STILL run last checked for a longer action in progress, and the answer.
-    hold: Option<(u32, Option<u64>)>,
+    /// The STILL run last checked for a longer action in progress, and the answer (its learnt
+    /// hold, µs: a library byte of 10 ms units, so u32 holds it; u64 would cost 12 bytes of
+    /// the RAM budget).
+    hold: Option<(u32, Option<u32>)>,
     /// The STILL run after which the phrase before it was last offered to [`nearest_action`],
     /// and the answer (None once acted on).
     nearest: Option<(u32, Option<Nearest>)>,
@@ -224,12 +226,13 @@ impl<'lib> Recognizer<'lib> {
                 let longer = match (self.decider.pending(), newest) {
                     (Some(p), Some(run)) if (PAUSE_US..LONG_PAUSE_US).contains(&still) => {
                         match self.hold {
-                            Some((r, v)) if r == run => v,
+                            Some((r, v)) if r == run => v.map(u64::from),
                             _ => {
                                 let v = self.longer_in_progress(&p);
-                                self.hold = Some((run, v));
+                                let kept = v.map(|h| u32::try_from(h).unwrap_or(u32::MAX));
+                                self.hold = Some((run, kept));
                                 first = true;
-                                v
+                                kept.map(u64::from)
                             }
                         }
                     }
