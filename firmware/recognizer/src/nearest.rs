@@ -26,7 +26,10 @@
 //! among those within [`CLOSED_SHARE`] whose examples it moved not too unlike
 //! ([`CLOSED_SHAPE_MAX`]): a small kick whose swing fell under the lever-arm threshold, read
 //! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
-//! When it moved plainly unlike every action's examples, it is none of them: a toy carried to
+//! A phrase that lost strokes may be all edits; one with more strokes than the action's
+//! shortest match may not ([`all_edits`]): a toy lifted, looked at and set down (`u .Xn .Xp
+//! d`) is no turn because a turn's `.Yp` is one token long and the look rotated. When it
+//! moved plainly unlike every action's examples, it is none of them: a toy carried to
 //! another spot or lifted and set back down is no action, however its strokes happen to be
 //! written.
 //!
@@ -187,7 +190,8 @@ pub fn nearest_action(
 
 /// The reading of a closed phrase ([`nearest_action`]) with the highest merit per aligned
 /// token, shape cost included ([`Candidate::merit`]), among the actions that read it within
-/// [`CLOSED_SHARE`] and whose examples it moved at most [`CLOSED_SHAPE_MAX`] unlike.
+/// [`CLOSED_SHARE`], not [`all_edits`], and whose examples it moved at most
+/// [`CLOSED_SHAPE_MAX`] unlike.
 fn closed_reading(
     lib: &Library<'_>,
     tokens: &[Token],
@@ -205,6 +209,9 @@ fn closed_reading(
         else {
             continue;
         };
+        if all_edits(c.cost, tokens.len(), c.min_len) {
+            continue;
+        }
         c.shape = shape_cost(penalty, aligned);
         // c.merit / aligned > t.merit / t_aligned, cross-multiplied.
         if top.is_none_or(|(t, t_aligned)| {
@@ -214,6 +221,16 @@ fn closed_reading(
         }
     }
     top.map(|(c, _)| c)
+}
+
+/// Whether a closed phrase of `len` moving tokens, read as an action whose shortest match is
+/// `min_len` tokens at `cost` half-edits, is all edits although it has more strokes than the
+/// action needs: a whole edit for every stroke, so nothing of it is that action's. A phrase
+/// no longer than the shortest match may be (its strokes fell under the thresholds: a small
+/// kick's `.Xn .Xp`); a longer one, off by a whole edit in each stroke, only has strokes
+/// to spare.
+fn all_edits(cost: u8, len: usize, min_len: u8) -> bool {
+    len > usize::from(min_len) && usize::from(cost) >= usize::from(FULL) * len
 }
 
 /// Another reading of candidate `c` (its runs `c.start..=c.end`, at most
@@ -393,7 +410,8 @@ pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 
 /// Edits per token a closed phrase (the stream ended, or the figurine rested
 /// [`OPEN_PHRASE_US`] after it) may be off the action it is read as when nothing nearer
-/// claims it ([`nearest_action`]), as (edits, tokens): any reading that is not mostly edits.
+/// claims it ([`nearest_action`]), as (edits, tokens): up to all of them, for a phrase that
+/// lost strokes; one with strokes to spare must keep some ([`all_edits`]).
 pub const CLOSED_SHARE: (usize, usize) = (1, 1);
 
 /// Most shape penalty ([`crate::shape::shape_penalty`], quarter tokens) an action may have
@@ -685,6 +703,54 @@ mod tests {
             .candidate,
             None
         );
+    }
+
+    #[test]
+    fn a_closed_phrase_with_strokes_to_spare_is_not_read_at_a_whole_edit_each() {
+        // A toy lifted, looked at (pitched down and back) and set down, against a turn `.Yp+`
+        // (one token long) whose examples moved as it did: each stroke is a whole edit off.
+        let (h, lifted) = moved(&[
+            ("u", 20, [0.0, 0.2, 0.0], 0.002),
+            (".Xn", 20, [0.0, 0.02, 0.02], 0.0),
+            (".Xp", 20, [0.0, 0.02, 0.02], 0.0),
+            ("d", 20, [0.0, 0.2, 0.0], -0.002),
+        ]);
+        let blob = seq_library(&[(&[".Yp"], 0)]);
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some(shape_bytes(lifted))]);
+        let lib = Library::from_bytes(&shaped).unwrap();
+        let toks = |names: &[&str]| -> std::vec::Vec<Token> {
+            names.iter().map(|n| parse_token(n).unwrap()).collect()
+        };
+        let look = toks(&["u", ".Xn", ".Xp", "d"]);
+        assert_eq!(
+            weighted_cost(&lib.pattern(0).unwrap(), &look, 255),
+            Some(4 * FULL)
+        );
+        let read = |h: &History, last: u32| {
+            nearest_action(&lib, h, 0, false, last, true)
+                .unwrap()
+                .candidate
+                .map(|c| (c.action, c.cost))
+        };
+        assert_eq!(read(&h, 4), None);
+        // With one stroke the turn's own, the rest to spare, it is the turn.
+        let (h, turned) = moved(&[
+            ("u", 20, [0.0, 0.2, 0.0], 0.002),
+            (".Yp", 20, [0.0, 0.02, 0.02], 0.0),
+            ("d", 20, [0.0, 0.2, 0.0], -0.002),
+        ]);
+        let shaped = crate::pattern::tests::with_shapes(&blob, &[Some(shape_bytes(turned))]);
+        let lib = Library::from_bytes(&shaped).unwrap();
+        let read = nearest_action(&lib, &h, 0, false, 3, true)
+            .unwrap()
+            .candidate
+            .map(|c| (c.action, c.cost));
+        assert_eq!(read, Some((0, 2 * FULL)));
+        // The rule itself: all edits is no reading only with strokes to spare.
+        assert!(all_edits(4 * FULL, 4, 1));
+        assert!(!all_edits(4 * FULL - HALF, 4, 1));
+        assert!(!all_edits(3 * FULL, 2, 3));
+        assert!(!all_edits(2 * FULL, 2, 2));
     }
 
     /// A shape as the shape table holds it ([`crate::pattern::tests::with_shapes`]).
