@@ -28,7 +28,7 @@
 //! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
 //! A phrase that lost strokes may be all edits; one with more strokes than the action's
 //! shortest match may not ([`all_edits`]): a toy lifted, looked at and set down (`u .Xn .Xp
-//! d`) is no turn because a turn's `.Yp` is one token long and the look rotated. When it
+//! d`) is no turn, whose `.Yp` is one token long and none of the four strokes. When it
 //! moved plainly unlike every action's examples, it is none of them: a toy carried to
 //! another spot or lifted and set back down is no action, however its strokes happen to be
 //! written.
