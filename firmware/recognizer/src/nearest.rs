@@ -27,7 +27,7 @@
 //! ([`CLOSED_SHAPE_MAX`]): a small kick whose swing fell under the lever-arm threshold, read
 //! as its pitch alone (`.Xn .Xp`), a whole edit per token from the kick's `uf.Xn b.Xp db`.
 //! A phrase that lost strokes may be all edits; one with more strokes than the action's
-//! shortest match may not ([`all_edits`]): a toy lifted, looked at and set down (`u .Xn .Xp
+//! shortest match may not (`all_edits`): a toy lifted, looked at and set down (`u .Xn .Xp
 //! d`) is no turn, whose `.Yp` is one token long and none of the four strokes. When it
 //! moved plainly unlike every action's examples, it is none of them: a toy carried to
 //! another spot or lifted and set back down is no action, however its strokes happen to be
@@ -190,7 +190,7 @@ pub fn nearest_action(
 
 /// The reading of a closed phrase ([`nearest_action`]) with the highest merit per aligned
 /// token, shape cost included ([`Candidate::merit`]), among the actions that read it within
-/// [`CLOSED_SHARE`], not [`all_edits`], and whose examples it moved at most
+/// [`CLOSED_SHARE`], not `all_edits`, and whose examples it moved at most
 /// [`CLOSED_SHAPE_MAX`] unlike.
 fn closed_reading(
     lib: &Library<'_>,
@@ -411,7 +411,7 @@ pub const PHRASE_SHARE: (usize, usize) = (2, 3);
 /// Edits per token a closed phrase (the stream ended, or the figurine rested
 /// [`OPEN_PHRASE_US`] after it) may be off the action it is read as when nothing nearer
 /// claims it ([`nearest_action`]), as (edits, tokens): up to all of them, for a phrase that
-/// lost strokes; one with strokes to spare must keep some ([`all_edits`]).
+/// lost strokes; one with strokes to spare must keep some (`all_edits`).
 pub const CLOSED_SHARE: (usize, usize) = (1, 1);
 
 /// Most shape penalty ([`crate::shape::shape_penalty`], quarter tokens) an action may have
