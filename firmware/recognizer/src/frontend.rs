@@ -6,13 +6,16 @@
 //! into the run each tick belongs to, keeping the recent runs in a [`History`]. Ticks of a
 //! token candidate are held in a side accumulator until the candidate is confirmed (they open
 //! the new run) or dropped (they go to the current run), so run boundaries and feature sums
-//! agree exactly. The host's learner and effort trainer use this same front end.
+//! agree exactly. The host's learner and effort trainer use this same front end. Each run
+//! also counts the sub-movements that began in it ([`crate::sweep`]); an example's front end
+//! counts them against the tracker's noise ([`Frontend::push_example`]).
 
 use crate::features::{Accum, FeatureExtractor};
 use crate::filter::SavGol;
 use crate::frame::{kinematics, Kinematics};
-use crate::history::History;
+use crate::history::{History, Sweeps};
 use crate::intake::{Accept, Intake, IntakeCounters, Sample};
+use crate::sweep::{SweepCounter, LEARN_MARGIN};
 use crate::token::{Token, TokenStep, Tokenizer, STILL};
 
 /// What one sample did to the run structure.
@@ -42,6 +45,7 @@ pub struct Frontend {
     cand_end: (u32, u64),
     /// The first and last quiet ticks among the candidate's.
     cand_quiet: Option<((u32, u64), (u32, u64))>,
+    sweep: SweepCounter,
     ticks: u32,
     last_tick_us: u64,
 }
@@ -59,6 +63,7 @@ impl Frontend {
             cand_start: (0, 0),
             cand_end: (0, 0),
             cand_quiet: None,
+            sweep: SweepCounter::new(),
             ticks: 0,
             last_tick_us: 0,
         }
@@ -90,7 +95,19 @@ impl Frontend {
     }
 
     /// Feeds one sample; `on` sees each run opening (at most a few per sample).
-    pub fn push(&mut self, s: &Sample, mut on: impl FnMut(&Self, FrontEvent)) {
+    pub fn push(&mut self, s: &Sample, on: impl FnMut(&Self, FrontEvent)) {
+        self.push_counting(s, false, on);
+    }
+
+    /// [`Frontend::push`] for a sample of an action's example: a rise or dip of the speed
+    /// counts as a sub-movement only when it also exceeds [`LEARN_MARGIN`] × the noise rms
+    /// learnt so far, so that what the examples require of a performance stands out of the
+    /// noise ([`crate::sweep`]).
+    pub fn push_example(&mut self, s: &Sample, on: impl FnMut(&Self, FrontEvent)) {
+        self.push_counting(s, true, on);
+    }
+
+    fn push_counting(&mut self, s: &Sample, example: bool, mut on: impl FnMut(&Self, FrontEvent)) {
         match self.intake.push(s) {
             Accept::Rejected => return,
             Accept::Accepted => {}
@@ -110,15 +127,26 @@ impl Frontend {
             self.ticks = self.ticks.saturating_add(1);
             self.last_tick_us = k.tick.t_us;
             let step = self.tokenizer.step(&k);
+            let moving = match step {
+                TokenStep::NewToken { token } => token != STILL,
+                _ => self.tokenizer.current().is_some_and(|t| t != STILL),
+            };
+            let margin = if example {
+                LEARN_MARGIN * self.tokenizer.noise_rms().0
+            } else {
+                0.0
+            };
+            let began = self.sweep.step(k.world_v, moving, margin);
             // Only a tick that may belong to a STILL run is checked (none of a moving run's).
             let may_rest = self.tokenizer.current() == Some(STILL) || step != TokenStep::Run;
             let quiet = may_rest && self.tokenizer.quiet(&k);
             match step {
-                TokenStep::Run => self.extend_current(&q, rise, &k, at, quiet),
+                TokenStep::Run => self.extend_current(&q, rise, &k, at, quiet, began),
                 TokenStep::Candidate => {
                     if self.cand.n == 0 {
                         self.cand_start = at;
                     }
+                    self.sweep.defer(began);
                     self.cand_end = at;
                     self.cand.add(&q, rise);
                     self.cand.travel(k.world_v, k.w);
@@ -128,8 +156,10 @@ impl Frontend {
                     let blip = core::mem::take(&mut self.cand);
                     let blip_end = self.cand_end;
                     let blip_quiet = self.cand_quiet.take();
+                    let blip_sweeps = self.sweep.take_deferred();
                     if let Some(r) = self.history.newest_mut() {
                         r.acc.merge(&blip);
+                        r.sweeps.merge(blip_sweeps);
                         r.end = blip_end;
                         if let (STILL, Some((first, last))) = (r.token, blip_quiet) {
                             r.mark_quiet(first);
@@ -137,19 +167,22 @@ impl Frontend {
                         }
                     }
                     if starts_candidate {
+                        self.sweep.defer(began);
                         self.cand_start = at;
                         self.cand_end = at;
                         self.cand.add(&q, rise);
                         self.cand.travel(k.world_v, k.w);
                         self.note_cand_quiet(at, quiet);
                     } else {
-                        self.extend_current(&q, rise, &k, at, quiet);
+                        self.extend_current(&q, rise, &k, at, quiet, began);
                     }
                 }
                 TokenStep::NewToken { token } => {
                     let start = if self.cand.n > 0 { self.cand_start } else { at };
                     let mut acc = core::mem::take(&mut self.cand);
                     let cand_quiet = self.cand_quiet.take();
+                    let mut sweeps = self.sweep.take_deferred();
+                    sweeps.merge(began);
                     acc.add(&q, rise);
                     if token != STILL {
                         acc.travel(k.world_v, k.w);
@@ -157,6 +190,7 @@ impl Frontend {
                     let index = self.history.open(token, start, acc);
                     if let Some(r) = self.history.newest_mut() {
                         r.end = at;
+                        r.sweeps = sweeps;
                         if token == STILL {
                             if let Some((first, last)) = cand_quiet {
                                 r.mark_quiet(first);
@@ -180,9 +214,11 @@ impl Frontend {
         k: &Kinematics,
         at: (u32, u64),
         quiet: bool,
+        began: Sweeps,
     ) {
         if let Some(r) = self.history.newest_mut() {
             r.acc.add(q, rise);
+            r.sweeps.merge(began);
             if r.token != STILL {
                 r.acc.travel(k.world_v, k.w);
             } else if quiet {
@@ -202,6 +238,7 @@ impl Frontend {
     }
 
     fn restart(&mut self) {
+        self.sweep = SweepCounter::new();
         self.filter.reset();
         self.features.reset();
         self.tokenizer.restart();

@@ -9,7 +9,7 @@
 //! ([`crate::noise::NoiseFloor::quiet`]): its first quiet tick, where the motion before it had
 //! settled, and its last, where the motion after it set off. An event is reported from the one
 //! to the other, so a slow onset or settle below the "moving" threshold is part of its span.
-//! RAM: `HISTORY_RUNS × 280` bytes ≈ 10.9 KiB.
+//! RAM: `HISTORY_RUNS × 296` bytes ≈ 11.6 KiB.
 
 use crate::features::Accum;
 use crate::token::{Token, STILL};
@@ -32,6 +32,33 @@ pub struct Run {
     pub first_quiet: Quiet,
     /// The last quiet tick, as an offset from `start`.
     pub last_quiet: Quiet,
+    /// Sub-movements that began in the run ([`crate::sweep`]); two bytes that were padding.
+    pub sweeps: Sweeps,
+}
+
+/// Sub-movements that began in a run ([`crate::sweep`]; saturating counts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Sweeps {
+    /// Speed peaks.
+    pub peaks: u8,
+    /// Bobs: a rise, then a fall.
+    pub bobs: u8,
+}
+
+impl Sweeps {
+    /// None yet.
+    pub const NONE: Sweeps = Sweeps { peaks: 0, bobs: 0 };
+
+    /// Adds the sub-movements of ticks that came after these.
+    pub fn merge(&mut self, o: Sweeps) {
+        self.peaks = self.peaks.saturating_add(o.peaks);
+        self.bobs = self.bobs.saturating_add(o.bobs);
+    }
+
+    /// How many sub-movements these were: the more of the two counts.
+    pub fn count(self) -> u8 {
+        self.peaks.max(self.bobs)
+    }
 }
 
 /// A tick inside a run as its offset from the run's first tick, in input samples;
@@ -71,6 +98,7 @@ impl Run {
         acc: Accum::new(),
         first_quiet: Quiet::NONE,
         last_quiet: Quiet::NONE,
+        sweeps: Sweeps::NONE,
     };
 
     /// Records a quiet tick `at` (seq, µs) of this run.
@@ -135,6 +163,7 @@ impl History {
                 acc,
                 first_quiet: Quiet::NONE,
                 last_quiet: Quiet::NONE,
+                sweeps: Sweeps::NONE,
             };
         }
         self.next = self.next.wrapping_add(1);

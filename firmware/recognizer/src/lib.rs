@@ -13,7 +13,9 @@
 //! tokens cost half; a match's motion against its action's: [`shape`]) → [`segment`] (online
 //! decision; stand-alone gestures no action matched given to their [`nearest`] action; a
 //! match right after an event may be its next piece, its rest or its settling: [`follow`]; a
-//! new event only when it went as far as its action's examples, not a fidget: [`extent`]) →
+//! new event only when it went as far as its action's examples, not a fidget: [`extent`], and
+//! was not one sweep of a hand carrying the toy where the examples made several pushes:
+//! [`sweep`]) →
 //! [`features`] (58 Laban features: the seed's 50, redefined, plus 8) → [`bayes`] (Time and
 //! Weight: naive Bayes or a linear discriminant per axis). [`frontend`] and
 //! [`history`] join the first stages; [`recognizer`] is the whole pipeline, and tells a
@@ -63,6 +65,7 @@ pub mod pattern;
 pub mod recognizer;
 pub mod segment;
 pub mod shape;
+pub mod sweep;
 pub mod token;
 
 pub use bayes::EffortModel;

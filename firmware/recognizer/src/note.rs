@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | [`Why::TooBrief`] | briefer than [`crate::segment::MIN_ACTION_US`], turned less than [`crate::segment::BRIEF_TURN_RAD`]: a flicker | segment |
 //! | [`Why::NotFarEnough`] | a new event that went less far (or, for an action whose examples travelled, ended less far away) than its action's examples allow: a fidget | [`crate::extent`] |
+//! | [`Why::OneSweep`] | a new event whose motion, from rest to rest, was one sweep, where its action's examples each made several pushes: a toy carried | [`crate::sweep`] |
 //! | [`Why::Settles`] | the settling of the event before it, which moved much more | [`crate::follow`] |
 //! | [`Why::Lost`] | its token runs had already left the history | [`crate::history`] |
 //! | [`Why::Reread`] | its motion was plainly unlike its action's examples: reported as the action it moved like | [`crate::nearest`] |
@@ -25,6 +26,9 @@ pub enum Why {
     TooBrief,
     /// Dropped: a new event that did not go (or travel) as far as its action's examples.
     NotFarEnough,
+    /// Dropped: a new event whose motion from rest to rest was one sweep, where each of its
+    /// action's examples made several sub-movements.
+    OneSweep,
     /// Dropped: the settling of the event before it.
     Settles,
     /// Dropped: its runs had left the history before it was committed.

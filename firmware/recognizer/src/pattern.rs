@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (9; version 8, whose shape table has only the first 17
-//!         bytes of each entry, is still read and its travel shares are not known; version 7,
+//! 0   4   magic "FGL" + version byte (10; version 9, whose shape table has only the first 18
+//!         bytes of each entry, is still read and its sub-movements are not known; version 8,
+//!         with only 17, is still read and its travel shares are not known either; version 7,
 //!         with only 16, is still read and its travels are not known either; version 6, with
 //!         only 15, is still read and its holds are not known either; version 5, with
 //!         only 13, is still read and its extents are not known either; versions 4, 3 and
@@ -29,9 +30,9 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 18 bytes per action in record order (the mean of its examples'
-//! shapes, `features::Shape`, how far they lay from it, how far the least of them went and
-//! how long they held still inside):
+//! then the shape table, 19 bytes per action in record order (the mean of its examples'
+//! shapes, `features::Shape`, how far they lay from it, how far the least of them went, how
+//! long they held still inside and how few sub-movements they made):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
 //! +3  1   0 = shape unknown (all fifteen bytes are zero); otherwise shape known (learnt
@@ -52,6 +53,8 @@
 //!         began it ended), code in `extent::MOVED_CODE_UNIT_M`; 0 = not known
 //! +17 1   the least share of how far an example went that it travelled (its travel over its
 //!         farthest displacement), × 255 rounded; 0 = none or not known
+//! +18 1   the fewest sub-movements an example made (`history::Sweeps::count`, counted
+//!         against the noise), at most 255; 0 = none or not known
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -69,9 +72,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 9;
+pub const LIBRARY_VERSION: u8 = 10;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 18;
+pub const SHAPE_BYTES: usize = 19;
+/// Bytes per action in a version 9 shape table (no sub-movements).
+const SHAPE_BYTES_V9: usize = 18;
+/// Offset of the fewest sub-movements in a shape-table entry.
+const SHAPE_SWEEPS_AT: usize = 18;
 /// Bytes per action in a version 8 shape table (no travel share).
 const SHAPE_BYTES_V8: usize = 17;
 /// Offset of the travel share in a shape-table entry.
@@ -106,7 +113,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,232).
+/// Largest valid library blob, bytes (12,264).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -321,6 +328,7 @@ impl<'a> Library<'a> {
             6 => SHAPE_BYTES_V6,
             7 => SHAPE_BYTES_V7,
             8 => SHAPE_BYTES_V8,
+            9 => SHAPE_BYTES_V9,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -417,6 +425,16 @@ impl<'a> Library<'a> {
             }),
             _ => None,
         }
+    }
+
+    /// The fewest sub-movements ([`crate::sweep`]) any of action `i`'s examples made (0: not
+    /// learnt, a library older than version 10).
+    pub fn least_sweeps(&self, i: usize) -> u8 {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_SWEEPS_AT {
+            return 0;
+        }
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_SWEEPS_AT;
+        self.bytes.get(at).copied().unwrap_or(0)
     }
 
     /// The longest stillness inside any of action `i`'s examples, µs: how long a performance
@@ -650,11 +668,19 @@ pub(crate) mod tests {
             out.extend([
                 to_byte(m, MOVED_CODE_UNIT_M),
                 to_byte(t, TURNED_CODE_UNIT_RAD),
-                0,
-                0,
-                0,
             ]);
+            out.extend([0; SHAPE_BYTES - 7 - SHAPE_DIMS - 2]);
         }
+        out
+    }
+
+    /// `blob` (the current version, with its shape table) with action `i`'s fewest
+    /// sub-movements set to `made`.
+    pub fn with_sweeps(blob: &[u8], i: usize, made: u8) -> Vec<u8> {
+        let mut out = blob.to_vec();
+        let n = usize::from(out[4]);
+        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_SWEEPS_AT;
+        out[at] = made;
         out
     }
 
@@ -803,6 +829,26 @@ pub(crate) mod tests {
             (e.travel_m - 0.0512).abs() < 1e-5 && e.travel_share == 0.0,
             "{e:?}"
         );
+        // The fewest sub-movements, a count (0: not known, as in a version 9 library, whose
+        // entries end at the travel share).
+        assert_eq!(Library::from_bytes(&ext).unwrap().least_sweeps(0), 0);
+        ext[entry + SHAPE_SWEEPS_AT] = 4;
+        let lib = Library::from_bytes(&ext).unwrap();
+        assert_eq!(
+            (
+                lib.least_sweeps(0),
+                lib.least_sweeps(1),
+                lib.least_sweeps(9)
+            ),
+            (4, 0, 0)
+        );
+        let mut v9 = v1.clone();
+        v9[3] = 9;
+        v9.extend(&ext[entry..entry + SHAPE_BYTES_V9]);
+        v9.extend([0; SHAPE_BYTES_V9]);
+        let lib = Library::from_bytes(&v9).unwrap();
+        assert_eq!(lib.least_sweeps(0), 0);
+        assert!(lib_extent(&v9).is_some_and(|e| (e.travel_share - 0.6).abs() < 1e-6));
         // The extents, both known or neither.
         assert_eq!(lib_extent(&tol), None);
         let mut ext = tol.clone();

@@ -142,7 +142,8 @@ pub fn log_events(
         .collect()
 }
 
-/// All token runs of a log (STILL included), in order, with their feature sums.
+/// All token runs of a log (STILL included), in order, with their feature sums and their
+/// sub-movements counted as an example's are ([`Frontend::push_example`]).
 pub fn log_runs(samples: &[(usize, Sample)]) -> Vec<Run> {
     log_runs_and_noise(samples).0
 }
@@ -169,7 +170,7 @@ pub fn log_runs_and_noise(samples: &[(usize, Sample)]) -> (Vec<Run>, (f32, f32))
     let mut front = Frontend::new();
     let mut runs = Vec::new();
     for (_, s) in samples {
-        front.push(s, |f, ev| {
+        front.push_example(s, |f, ev| {
             if let FrontEvent::Opened { index, .. } = ev {
                 if let Some(prev) = f.history().get(index.wrapping_sub(1)) {
                     runs.push(*prev);

@@ -20,7 +20,7 @@ use anyhow::Result;
 use clap::Args;
 use figurine_recognizer::extent::{Extent, ExtentSums};
 use figurine_recognizer::features::{Shape, ShapeSums};
-use figurine_recognizer::history::Run;
+use figurine_recognizer::history::{Run, Sweeps};
 use figurine_recognizer::shape::SHAPE_SCALE;
 use figurine_recognizer::token::STILL;
 
@@ -128,6 +128,20 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
         .flat_map(|g| g.iter().filter(|r| r.token == STILL))
         .map(|r| run_seconds(r) as f32)
         .reduce(f32::max)
+}
+
+/// The fewest sub-movements ([`Sweeps::count`]) any of the
+/// gestures that moved made; None without one.
+pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<u8> {
+    gestures
+        .into_iter()
+        .filter(|g| !g.is_empty())
+        .map(|g| {
+            let mut made = Sweeps::NONE;
+            g.iter().for_each(|r| made.merge(r.sweeps));
+            made.count()
+        })
+        .min()
 }
 
 /// The least extent among gestures that moved, dimension by dimension (and the least share of
@@ -246,7 +260,8 @@ pub fn learn_action(
     .with_shape(mean_shape(&shapes))
     .with_shape_tolerance(shape_tolerance(&shapes))
     .with_extent(least_extent(read.iter().map(|e| &e.runs[..])))
-    .with_hold(longest_hold(read.iter().map(|e| &e.runs[..])));
+    .with_hold(longest_hold(read.iter().map(|e| &e.runs[..])))
+    .with_sweeps(fewest_sweeps(read.iter().map(|e| &e.runs[..])));
     Ok(entry)
 }
 
@@ -478,6 +493,21 @@ mod tests {
             assert!(walk > 0.9 && jump > 0.3, "walk {walk} jump {jump}");
             assert!(punch < 0.2 && crouch < 0.2, "punch {punch} crouch {crouch}");
         }
+    }
+
+    #[test]
+    fn a_walk_is_several_pushes_where_a_toy_carried_is_one_sweep() {
+        // Counted as examples are, against the noise: what a library asks of a performance.
+        let made = |log: &PoseLog| fewest_sweeps([&log_gesture(log)[..]]).unwrap_or(0);
+        for seed in [1, 2, 3] {
+            for action in [Action::Walk, Action::Sidestep, Action::Run] {
+                let entry = learn_action("a", &example_logs(action, seed), None, false).unwrap();
+                assert!(entry.sweeps >= Some(2), "{action:?} {:?}", entry.sweeps);
+            }
+            let carried = synth::handled(seed, &Knobs::default(), synth::Handling::Reposition);
+            assert_eq!(made(&carried.log), 1, "a carry, seed {seed}");
+        }
+        assert_eq!(fewest_sweeps(std::iter::empty::<&[Run]>()), None);
     }
 
     #[test]

@@ -95,6 +95,12 @@ pub struct ActionEntry {
     /// pattern written by hand, or learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hold_s: Option<f32>,
+    /// The fewest sub-movements any example made (`figurine_recognizer::sweep`), counted
+    /// against the tracker's noise: when every example made several, one sweep of a hand
+    /// carrying the toy is none of this action. Absent for a pattern written by hand, or
+    /// learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweeps: Option<u8>,
 }
 
 /// Human-readable compiled automaton.
@@ -184,6 +190,7 @@ impl ActionEntry {
             travel_m: None,
             travel_share: None,
             hold_s: None,
+            sweeps: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
@@ -221,6 +228,13 @@ impl ActionEntry {
     /// The same entry with the examples' longest hold `hold_s` (see [`ActionEntry::hold_s`]).
     pub fn with_hold(mut self, hold_s: Option<f32>) -> Self {
         self.hold_s = hold_s.filter(|h| h.is_finite() && *h > 0.0);
+        self
+    }
+
+    /// The same entry with the fewest sub-movements its examples made (see
+    /// [`ActionEntry::sweeps`]).
+    pub fn with_sweeps(mut self, sweeps: Option<u8>) -> Self {
+        self.sweeps = sweeps;
         self
     }
 
@@ -275,6 +289,7 @@ impl ActionEntry {
                     self.travel_share
                         .filter(|t| t.is_finite() && extent.is_some())
                         .map_or(0, q),
+                    self.sweeps.unwrap_or(0),
                 ]
             }
             _ => [0; SHAPE_BYTES],

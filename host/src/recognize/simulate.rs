@@ -15,6 +15,7 @@ use clap::Args;
 use figurine_recognizer::history::Run;
 use figurine_recognizer::intake::MAX_GAP_US;
 use figurine_recognizer::segment::{BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
+use figurine_recognizer::sweep::MANY_SWEEPS;
 use figurine_recognizer::token::{Token, STILL};
 use figurine_recognizer::{
     ActionEvent, EffortModel, Library, Note, Recognizer, Sample, Stats, Why,
@@ -399,6 +400,10 @@ pub fn why_words(n: &Note, names: &[String]) -> String {
         Why::NotFarEnough => format!(
             "dropped: a new event that went (or travelled) less far than `{action}`'s \
              examples allow (a fidget)"
+        ),
+        Why::OneSweep => format!(
+            "dropped: a new event whose motion, from rest to rest, was one sweep of the hand, \
+             where each of `{action}`'s examples made {MANY_SWEEPS} or more (a toy carried)"
         ),
         Why::Settles => "dropped: the settling of the event before it".into(),
         Why::Lost => "dropped: its motion had left the recognizer's history".into(),

@@ -18,6 +18,7 @@ use crate::intake::TICK_S;
 use crate::nearest::reread;
 use crate::note::{Note, Why};
 use crate::segment::{Candidate, BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
+use crate::sweep::carried;
 use crate::token::STILL;
 
 use super::{ActionEvent, Recognizer, Sink};
@@ -52,15 +53,23 @@ impl<'lib> Recognizer<'lib> {
         held: Option<Held>,
     ) -> Result<(Held, bool, Option<Held>), Why> {
         let (ev, (from, to)) = self.event_of(c)?;
-        // Only a new event is held to its action's extent; a continuation's went before. A
-        // fidget seems to go as far as the tracker's noise takes it besides.
+        // Only a new event is held to its action's extent and sub-movements; a continuation's
+        // went before. A fidget seems to go as far as the tracker's noise takes it besides.
         let hist = self.front.history();
         let noise = noise_reach(self.front.noise_rms());
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
             Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => {
                 Err(Why::NotFarEnough)
             }
-            _ => Ok((ev, false, Some(ev))),
+            Some(least) => {
+                let made = self.library.least_sweeps(usize::from(ev.action));
+                if carried(least, made, c.cost, hist, from, to) {
+                    Err(Why::OneSweep)
+                } else {
+                    Ok((ev, false, Some(ev)))
+                }
+            }
+            None => Ok((ev, false, Some(ev))),
         };
         let Some(mut h) = held else {
             return new(ev);
@@ -414,6 +423,49 @@ mod tests {
         // 30° there and back: a turn played small, but played.
         let ev = run(&lib, &twists(0.5, 0.06, Some(0.3)));
         assert_eq!(ev.len(), 1, "{ev:?}");
+    }
+
+    /// Still, then `pushes` strokes forward of 0.4 s and 10 cm each, the speed falling to
+    /// nothing between them, then still; 120 Hz.
+    fn pushes_forward(pushes: usize) -> Vec<crate::intake::Sample> {
+        let rate = 120.0f32;
+        let (still, stroke) = (0.6f32, 0.4f32);
+        let total = 2.0 * still + pushes as f32 * stroke;
+        (0..(total * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let h = ((t - still) / stroke).clamp(0.0, pushes as f32);
+                let k = libm::floorf(h);
+                crate::intake::Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, 1.0, 0.1 * (k + ramp(h - k))],
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_sweep_is_a_toy_carried_where_the_examples_made_several_pushes() {
+        // A forward stroke, learnt from examples that went at least 20 cm.
+        let blob = seq_library(&[(&["f"], 0)]);
+        let learnt = crate::pattern::tests::with_extents(&blob, &[(0.2, 0.05)]);
+        let carry = pushes_forward(1);
+        let lib = Library::from_bytes(&learnt).unwrap();
+        let (ev, notes) = run_noted(&lib, &carry);
+        assert_eq!(ev.len(), 1, "sub-movements not learnt: {ev:?} {notes:?}");
+        // Its examples each made two: a performance may be one push and its settling.
+        let two = crate::pattern::tests::with_sweeps(&learnt, 0, 2);
+        assert_eq!(run(&Library::from_bytes(&two).unwrap(), &carry).len(), 1);
+        // Three or more: one sweep from rest to rest is a toy carried, three pushes are not.
+        let three = crate::pattern::tests::with_sweeps(&learnt, 0, 3);
+        let lib = Library::from_bytes(&three).unwrap();
+        let (ev, notes) = run_noted(&lib, &carry);
+        assert_eq!(ev, []);
+        assert!(notes.iter().any(|n| n.why == Why::OneSweep), "{notes:?}");
+        let (ev, notes) = run_noted(&lib, &pushes_forward(3));
+        assert_eq!(ev.len(), 1, "{ev:?} {notes:?}");
     }
 
     #[test]
