@@ -359,8 +359,12 @@ pub fn run(args: &LearnArgs) -> Result<()> {
     let shape = entry.shape.map_or(String::new(), |[l, u, f]| {
         format!(", moves left/up/front {l:.2}/{u:.2}/{f:.2} of its speed")
     });
+    // What one sweep of a hand is measured against (`figurine_recognizer::sweep`).
+    let pushes = entry.sweeps.map_or(String::new(), |n| {
+        format!(", each example {n} or more sub-movements")
+    });
     println!(
-        "{}: {}  (max {} edits{shape})",
+        "{}: {}  (max {} edits{shape}{pushes})",
         entry.name, entry.regex, entry.max_edits
     );
     lib.upsert(entry);
