@@ -192,7 +192,7 @@ fn a_toy_carried_in_one_sweep_is_no_action_whose_examples_made_several_pushes() 
             }
         }
     }
-    // Libraries 21–23: 38 of the 90 carries read as an action, 50 without the counts; 155 and
+    // Libraries 21–23: 38 of the 90 carries read as an action, 50 without the counts; 153 and
     // 152 of the performances read as played.
     assert!(
         loud_with + 8 <= loud_without,

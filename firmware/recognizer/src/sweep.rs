@@ -21,7 +21,8 @@
 //! each made [`MANY_SWEEPS`] or more, and its match cost at most [`SWEEP_COST`] (its pattern
 //! as written, bar one near token): a match that needed an edit may have left out the very
 //! parts that make sub-movements (a jump played as one arc, without its crouch). Only for an
-//! action that moving carries ([`crate::extent`]): a turn is one sweep of the wrist.
+//! action that moving carries ([`crate::extent`]): a turn is one sweep of the wrist; and only
+//! for a motion long enough for several pushes to be told apart ([`RESOLVABLE_US`]).
 //!
 //! RAM: the counter's 8 B, a token candidate's counts included; a run's counts take two bytes
 //! that were its padding.
@@ -44,6 +45,12 @@ pub const LEARN_MARGIN: f32 = 2.5;
 /// Sub-movements every example of an action must have made for one sweep to be refused as
 /// that action: an action whose examples made two may be played as one push and its settling.
 pub const MANY_SWEEPS: u8 = 3;
+/// Least time a motion takes, from rest to rest, for its one sweep to be refused, µs: the
+/// time [`MANY_SWEEPS`] pushes need for the filter to tell them apart, a window
+/// ([`crate::filter::SG_WINDOW`] ticks) each (330 ms). Briefer, a performance's pushes blur
+/// into one (a run played small and sudden, 0.2 s across a tabletop).
+pub const RESOLVABLE_US: u64 =
+    MANY_SWEEPS as u64 * crate::filter::SG_WINDOW as u64 * crate::intake::TICK_US;
 /// Most a match may cost, in half-edits ([`crate::alignment`]), for one sweep to be refused
 /// as its action: its pattern as written, or with one near token.
 pub const SWEEP_COST: u8 = crate::alignment::HALF;
@@ -128,7 +135,8 @@ pub fn carried(least: Extent, made: u8, cost: u8, hist: &History, from: u32, to:
 
 /// Whether the motion of runs `from..=to` of `hist`, with the moving runs just before it back
 /// to the last rest, made at most one sub-movement and came to rest after: one sweep, from
-/// rest to rest. False when the run after `to` is not yet a STILL one (the motion goes on).
+/// rest to rest. False when the run after `to` is not yet a STILL one (the motion goes on),
+/// and when the motion was briefer than [`RESOLVABLE_US`].
 pub fn one_sweep(hist: &History, from: u32, to: u32) -> bool {
     if hist
         .get(to.wrapping_add(1))
@@ -137,6 +145,8 @@ pub fn one_sweep(hist: &History, from: u32, to: u32) -> bool {
         return false;
     }
     let mut made = Sweeps::NONE;
+    let ended_us = hist.get(to).map_or(0, |r| r.end.1);
+    let mut began_us = hist.get(from).map_or(0, |r| r.start.1);
     let mut i = from;
     for _ in 0..HISTORY_RUNS {
         if let Some(r) = hist.get(i) {
@@ -151,11 +161,14 @@ pub fn one_sweep(hist: &History, from: u32, to: u32) -> bool {
     for _ in 0..HISTORY_RUNS {
         j = j.wrapping_sub(1);
         match hist.get(j) {
-            Some(r) if r.token != STILL => made.merge(r.sweeps),
+            Some(r) if r.token != STILL => {
+                made.merge(r.sweeps);
+                began_us = r.start.1;
+            }
             _ => break,
         }
     }
-    made.count() <= 1
+    ended_us.saturating_sub(began_us) >= RESOLVABLE_US && made.count() <= 1
 }
 
 #[cfg(test)]
@@ -263,12 +276,15 @@ mod tests {
         );
     }
 
-    fn history(runs: &[(crate::token::Token, u8)]) -> History {
+    /// Runs of `run_ms` each, one after the other, with the speed peaks given.
+    fn history(runs: &[(crate::token::Token, u8)], run_ms: u64) -> History {
         let mut h = History::new();
-        for &(token, peaks) in runs {
-            h.open(token, (0, 0), Accum::new());
+        for (k, &(token, peaks)) in runs.iter().enumerate() {
+            let start_us = k as u64 * run_ms * 1000;
+            h.open(token, (k as u32, start_us), Accum::new());
             if let Some(r) = h.newest_mut() {
                 r.sweeps = Sweeps { peaks, bobs: 0 };
+                r.end = (k as u32, start_us + run_ms * 1000 - 10_000);
             }
         }
         h
@@ -278,16 +294,20 @@ mod tests {
     fn one_sweep_reads_from_rest_to_rest() {
         let m: crate::token::Token = 0;
         // rest, one push over two runs, rest
-        let h = history(&[(STILL, 0), (m, 1), (m, 0), (STILL, 0)]);
+        let h = history(&[(STILL, 0), (m, 1), (m, 0), (STILL, 0)], 200);
         assert!(one_sweep(&h, 1, 2));
         // The event's runs alone made one; the run before it, since the rest, made another.
-        let h = history(&[(STILL, 0), (m, 1), (m, 1), (m, 0), (STILL, 0)]);
+        let h = history(&[(STILL, 0), (m, 1), (m, 1), (m, 0), (STILL, 0)], 200);
         assert!(!one_sweep(&h, 2, 3));
         // Not yet at rest after it: the motion may go on.
-        let h = history(&[(STILL, 0), (m, 1), (m, 0)]);
+        let h = history(&[(STILL, 0), (m, 1), (m, 0)], 200);
         assert!(!one_sweep(&h, 1, 1));
         // Two pushes.
-        let h = history(&[(STILL, 0), (m, 1), (m, 1), (STILL, 0)]);
+        let h = history(&[(STILL, 0), (m, 1), (m, 1), (STILL, 0)], 200);
         assert!(!one_sweep(&h, 1, 2));
+        // Too brief for several pushes to be told apart: 0.3 s from rest to rest.
+        let h = history(&[(STILL, 0), (m, 1), (m, 0), (STILL, 0)], 150);
+        assert!(!one_sweep(&h, 1, 2));
+        assert_eq!(RESOLVABLE_US, 330_000);
     }
 }
