@@ -63,7 +63,7 @@ pub struct SweepCounter {
     /// A bob has risen and not yet fallen.
     risen: bool,
     /// Inside a peak, its highest speed; outside, the least speed since the last peak ended
-    /// (m/s): one or the other is ever needed, and RAM is the device's to spare.
+    /// (m/s): only one of the two is ever needed, and the device's RAM is scarce.
     extreme: f32,
     /// Sub-movements of ticks whose run is not yet known (a token candidate's).
     deferred: Sweeps,

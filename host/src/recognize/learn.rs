@@ -12,7 +12,8 @@
 //!
 //! Besides its pattern, an action keeps what its examples say of how it moves: its motion
 //! shape and how much that varied ([`mean_shape`], [`shape_tolerance`]), how far the least of
-//! them went ([`least_extent`]) and the longest stillness inside one ([`longest_hold`]).
+//! them went ([`least_extent`]), the longest stillness inside one ([`longest_hold`]) and the
+//! fewest sub-movements one made ([`fewest_sweeps`]).
 
 use std::path::PathBuf;
 
@@ -130,8 +131,8 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
         .reduce(f32::max)
 }
 
-/// The fewest sub-movements ([`Sweeps::count`]) any of the
-/// gestures that moved made; None without one.
+/// The fewest sub-movements ([`Sweeps::count`]) any of the gestures that moved made; None
+/// without one.
 pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<u8> {
     gestures
         .into_iter()
