@@ -10,7 +10,7 @@
 //! also counts the sub-movements that began in it ([`crate::sweep`]); an example's front end
 //! counts them against the tracker's noise ([`Frontend::push_example`]).
 
-use crate::features::{Accum, FeatureExtractor};
+use crate::features::{Accum, FeatureExtractor, SPEED};
 use crate::filter::SavGol;
 use crate::frame::{kinematics, Kinematics};
 use crate::history::{History, Sweeps};
@@ -127,16 +127,15 @@ impl Frontend {
             self.ticks = self.ticks.saturating_add(1);
             self.last_tick_us = k.tick.t_us;
             let step = self.tokenizer.step(&k);
-            let moving = match step {
-                TokenStep::NewToken { token } => token != STILL,
-                _ => self.tokenizer.current().is_some_and(|t| t != STILL),
-            };
+            // After the step, the current token is the new one's (a TURN marker's rotation).
+            let moving = self.tokenizer.current().is_some_and(|t| t != STILL);
             let margin = if example {
                 LEARN_MARGIN * self.tokenizer.noise_rms().0
             } else {
                 0.0
             };
-            let began = self.sweep.step(k.world_v, moving, margin);
+            // The speed is the features' own |world v| (one square root a tick, not two).
+            let began = self.sweep.step(q[SPEED], k.world_v[1], moving, margin);
             // Only a tick that may belong to a STILL run is checked (none of a moving run's).
             let may_rest = self.tokenizer.current() == Some(STILL) || step != TokenStep::Run;
             let quiet = may_rest && self.tokenizer.quiet(&k);

@@ -90,10 +90,10 @@ impl SweepCounter {
         core::mem::take(&mut self.deferred)
     }
 
-    /// One tick of world velocity `v` (m/s, +Y up), while `moving` (not STILL) or not; a rise
-    /// or dip must also exceed `margin` (m/s) to count. Returns what began on this tick.
-    pub fn step(&mut self, v: [f32; 3], moving: bool, margin: f32) -> Sweeps {
-        let speed = fmath::norm3(v);
+    /// One tick of `speed` and vertical speed `up` (m/s, world +Y), while `moving` (not STILL)
+    /// or not; a rise or dip must also exceed `margin` (m/s) to count. Returns what began on
+    /// this tick.
+    pub fn step(&mut self, speed: f32, up: f32, moving: bool, margin: f32) -> Sweeps {
         let mut began = Sweeps::NONE;
         if self.in_peak {
             self.extreme = fmath::max(self.extreme, speed);
@@ -110,7 +110,6 @@ impl SweepCounter {
             }
         }
         if moving {
-            let up = v[1];
             if up > BOB_SHARE * speed && up > margin {
                 self.risen = true;
             } else if -up > BOB_SHARE * speed && -up > margin && self.risen {
@@ -147,16 +146,7 @@ pub fn one_sweep(hist: &History, from: u32, to: u32) -> bool {
     let mut made = Sweeps::NONE;
     let ended_us = hist.get(to).map_or(0, |r| r.end.1);
     let mut began_us = hist.get(from).map_or(0, |r| r.start.1);
-    let mut i = from;
-    for _ in 0..HISTORY_RUNS {
-        if let Some(r) = hist.get(i) {
-            made.merge(r.sweeps);
-        }
-        if i == to {
-            break;
-        }
-        i = i.wrapping_add(1);
-    }
+    hist.runs(from, to).for_each(|r| made.merge(r.sweeps));
     let mut j = from;
     for _ in 0..HISTORY_RUNS {
         j = j.wrapping_sub(1);
@@ -184,7 +174,8 @@ mod tests {
         let mut made = Sweeps::NONE;
         for k in 0..n {
             let v = v(k as f32 * 0.01);
-            made.merge(c.step(v, fmath::norm3(v) > crate::noise::V_FLOOR_M_S, margin));
+            let speed = fmath::norm3(v);
+            made.merge(c.step(speed, v[1], speed > crate::noise::V_FLOOR_M_S, margin));
         }
         made
     }
@@ -256,7 +247,7 @@ mod tests {
     fn still_ticks_begin_nothing() {
         let mut c = SweepCounter::new();
         for _ in 0..50 {
-            assert_eq!(c.step([0.5, 0.2, 0.0], false, 0.0), Sweeps::NONE);
+            assert_eq!(c.step(0.54, 0.2, false, 0.0), Sweeps::NONE);
         }
     }
 
