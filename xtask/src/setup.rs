@@ -5,8 +5,9 @@
 //!   tests), `mesa-vulkan-drivers` + `libvulkan1` (lavapipe, headless rendering), `ffmpeg`
 //!   (MP4 output), `python3-venv`, `nodejs` + `npm` (independent BVH and glTF validators),
 //!   `g++` (libFuzzer, which cargo-fuzz builds from C++ sources), `slurm-wlm` + `munge` (the
-//!   Slurm job array of the distributed graph build, tests/graph_tiles.rs and the bench),
-//!   `libapriltag-dev` + `pkg-config` (the AprilTag detector behind `figurine track`).
+//!   Slurm job array of the distributed graph build, tests/graph_tiles.rs and the bench). The
+//!   AprilTag detector behind `figurine track` needs none: `apriltag-sys` compiles its bundled
+//!   source with the C compiler (`.cargo/config.toml`).
 //! * Validators used by tests: Python's `bvh` package in `target/tools/pyenv`, Khronos'
 //!   `gltf-validator` from npm in `target/tools/node`.
 //! * cargo-fuzz from crates.io when missing (the fuzz smoke of `cargo xtask test`).
@@ -33,9 +34,6 @@ const APT_PACKAGES: &[(&str, &str)] = &[
     // configured or needed).
     ("slurm-wlm", ""),
     ("munge", ""),
-    // The AprilTag detector behind `figurine track` (apriltag-sys finds it with pkg-config).
-    ("libapriltag-dev", ""),
-    ("pkg-config", "pkg-config"),
 ];
 
 fn dpkg_installed(pkg: &str) -> bool {

@@ -1,27 +1,28 @@
-//! The AprilTag detector: Debian's libapriltag 3.3 through the `apriltag-sys` binding, wrapped
-//! so that the rest of the tracker never touches a raw pointer.
+//! The AprilTag detector: the upstream library 3.4.5 that `apriltag-sys` bundles, compiled into
+//! the host (`.cargo/config.toml` sets `APRILTAG_SYS_METHOD`), wrapped so that the rest of the
+//! tracker never touches a raw pointer.
 //!
-//! What the wrapper relies on, from `apriltag.h`/`apriltag_pose.h` 3.3.0:
+//! Not Debian's libapriltag 3.3.0: its worker pool lets a thread woken spuriously read a task
+//! while the next is being added, and the tasks' array may move under it (AprilRobotics/apriltag
+//! #339, fixed in 3.4): a test run of the host crashed with SIGSEGV inside a detection with two
+//! threads. Compiling the bundled source also keeps the library and the crate's generated
+//! bindings the same version.
+//!
+//! What the wrapper relies on, from `apriltag.h`/`apriltag_pose.h`:
 //! * a detector owns no family: the family must outlive it, so [`Detector`] drops the
 //!   detector first;
 //! * `apriltag_detector_detect` only reads the image, and returns a `zarray` of
 //!   `apriltag_detection_t*` that `apriltag_detections_destroy` frees;
 //! * the corners `p[0..4]` wrap counter-clockwise in the image, starting at the tag's
 //!   bottom-left as printed;
-//! * `apriltag_to_image` allocates the image and its pixels separately with `malloc`-family
-//!   calls, and the library does not export `image_u8_destroy`, so both are `free`d here.
+//! * `apriltag_to_image` returns an image the caller frees with `image_u8_destroy`.
 //!
-//! The pose is not taken from the library's `estimate_tag_pose`: its matrices (`matd_t`) are
-//! a flexible array in Debian's 3.3 but a pointer in the source `apriltag-sys` bundles, and
-//! `matd_destroy` is not exported either; [`super::pnp`] solves it from the corners instead.
+//! The pose is not taken from the library's `estimate_tag_pose`: [`super::pnp`] solves it from
+//! the corners, for the pose and its mirror, refined on all four (the library's own estimate
+//! keeps one of the two and needs `matd_t` matrices freed across the boundary).
 #![allow(unsafe_code)]
 
 use apriltag_sys as sys;
-
-extern "C" {
-    /// The C library's `free`, for what libapriltag allocates and exports no destructor for.
-    fn free(p: *mut std::ffi::c_void);
-}
 
 use super::TrackError;
 
@@ -139,8 +140,7 @@ pub fn tag_pattern(family: Family, id: u32) -> Result<TagPattern, TrackError> {
                 black.push(*(*im).buf.add((y * stride + x) as usize) < 128);
             }
         }
-        free((*im).buf.cast());
-        free(im.cast());
+        sys::image_u8_destroy(im);
         if w != h || w <= 0 {
             return Err(TrackError::Detector(format!("tag image is {w}×{h}")));
         }
@@ -233,7 +233,7 @@ pub struct Detection {
     pub center: [f64; 2],
 }
 
-/// Edge of the tiles libapriltag 3.3 thresholds a frame by, pixels (`apriltag_quad_thresh.c`:
+/// Edge of the tiles libapriltag thresholds a frame by, pixels (`apriltag_quad_thresh.c`:
 /// `tilesz = 4`), counted from the frame's top-left corner.
 const THRESHOLD_TILE_PX: usize = 4;
 
@@ -494,7 +494,7 @@ impl Detector {
             buf: self.scratch.as_mut_ptr(),
         };
         // SAFETY: `det` is live; the library re-creates its worker pool when the count
-        // changes (`apriltag_detector_detect`, 3.3), which happens only when the tracker
+        // changes (`apriltag_detector_detect`), which happens only when the tracker
         // falls back to the whole frame or returns to the region.
         unsafe {
             (*self.det).nthreads = if whole { self.threads } else { 1 };
