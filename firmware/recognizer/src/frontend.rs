@@ -7,15 +7,16 @@
 //! token candidate are held in a side accumulator until the candidate is confirmed (they open
 //! the new run) or dropped (they go to the current run), so run boundaries and feature sums
 //! agree exactly. The host's learner and effort trainer use this same front end. Each run
-//! also counts the sub-movements that began in it ([`crate::sweep`]); an example's front end
-//! counts them against the tracker's noise ([`Frontend::push_example`]).
+//! also counts the sub-movements that began in it ([`crate::sweep`]), against the tracker's
+//! noise: a performance's by [`EVENT_MARGIN`] × its rms, an example's by [`LEARN_MARGIN`] ×
+//! ([`Frontend::push_example`]).
 
 use crate::features::{Accum, FeatureExtractor, SPEED};
 use crate::filter::SavGol;
 use crate::frame::{kinematics, Kinematics};
 use crate::history::{History, Sweeps};
 use crate::intake::{Accept, Intake, IntakeCounters, Sample};
-use crate::sweep::{SweepCounter, LEARN_MARGIN};
+use crate::sweep::{SweepCounter, EVENT_MARGIN, LEARN_MARGIN};
 use crate::token::{Token, TokenStep, Tokenizer, STILL};
 
 /// What one sample did to the run structure.
@@ -96,7 +97,7 @@ impl Frontend {
 
     /// Feeds one sample; `on` sees each run opening (at most a few per sample).
     pub fn push(&mut self, s: &Sample, on: impl FnMut(&Self, FrontEvent)) {
-        self.push_counting(s, false, on);
+        self.push_counting(s, EVENT_MARGIN, on);
     }
 
     /// [`Frontend::push`] for a sample of an action's example: a rise or dip of the speed
@@ -104,10 +105,12 @@ impl Frontend {
     /// learnt so far, so that what the examples require of a performance stands out of the
     /// noise ([`crate::sweep`]).
     pub fn push_example(&mut self, s: &Sample, on: impl FnMut(&Self, FrontEvent)) {
-        self.push_counting(s, true, on);
+        self.push_counting(s, LEARN_MARGIN, on);
     }
 
-    fn push_counting(&mut self, s: &Sample, example: bool, mut on: impl FnMut(&Self, FrontEvent)) {
+    /// [`Frontend::push`], a sub-movement counting when it also rises or dips by `margin` ×
+    /// the noise rms learnt so far.
+    fn push_counting(&mut self, s: &Sample, margin: f32, mut on: impl FnMut(&Self, FrontEvent)) {
         match self.intake.push(s) {
             Accept::Rejected => return,
             Accept::Accepted => {}
@@ -129,11 +132,7 @@ impl Frontend {
             let step = self.tokenizer.step(&k);
             // After the step, the current token is the new one's (a TURN marker's rotation).
             let moving = self.tokenizer.current().is_some_and(|t| t != STILL);
-            let margin = if example {
-                LEARN_MARGIN * self.tokenizer.noise_rms().0
-            } else {
-                0.0
-            };
+            let margin = margin * self.tokenizer.noise_rms().0;
             // The speed is the features' own |world v| (one square root a tick, not two).
             let began = self.sweep.step(q[SPEED], k.world_v[1], moving, margin);
             // Only a tick that may belong to a STILL run is checked (none of a moving run's).
@@ -244,5 +243,92 @@ impl Frontend {
         self.history.clear();
         self.cand = Accum::new();
         self.cand_quiet = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use core::f32::consts::PI;
+    use std::vec::Vec;
+
+    /// Deterministic noise, uniform in [−1, 1] (xorshift32).
+    struct Noise(u32);
+
+    impl Noise {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            self.0 as f32 / u32::MAX as f32 * 2.0 - 1.0
+        }
+    }
+
+    /// The toy moved 30 cm across in `pushes` minimum-jerk pushes over 0.8 s, lifted 4 cm and
+    /// set down in each, after 2 s at rest and before 1.5 s more, at 120 Hz: a hand's 9 Hz
+    /// tremor of `tremor` m along the motion (half as much up), each coordinate jittered
+    /// uniformly by ±`jitter` m; the rest lets the front end learn that noise.
+    fn handled(pushes: u32, jitter: f32, tremor: f32, seed: u32) -> Vec<Sample> {
+        let mut noise = Noise(seed);
+        let n = pushes as f32;
+        (0..(4.3 * 120.0) as u32)
+            .map(|i| {
+                let t = i as f32 / 120.0;
+                let along = ((t - 2.0) / 0.8).clamp(0.0, 1.0) * n;
+                let done = libm::floorf(along).min(n - 1.0);
+                let s = along - done;
+                let reach = (done + s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)) / n;
+                let lift = 0.04 * libm::sinf(PI * s);
+                let shake = tremor * libm::sinf(2.0 * PI * 9.0 * t + seed as f32);
+                Sample {
+                    seq: i,
+                    t_us: u64::from(i) * 1_000_000 / 120,
+                    pos: [
+                        0.3 * reach + shake + jitter * noise.next(),
+                        1.0 + lift + 0.5 * shake + jitter * noise.next(),
+                        jitter * noise.next(),
+                    ],
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    /// The sub-movements counted over every run of `samples`, each rise or dip held to
+    /// `margin` × the learnt noise rms.
+    fn counted(samples: &[Sample], margin: f32) -> u8 {
+        let mut f = Frontend::new();
+        for s in samples {
+            f.push_counting(s, margin, |_, _| {});
+        }
+        let h = f.history();
+        let (Some(from), Some(to)) = (h.oldest(), h.newest()) else {
+            return 0;
+        };
+        let mut made = Sweeps::NONE;
+        h.runs(from, to).for_each(|r| made.merge(r.sweeps));
+        made.count()
+    }
+
+    #[test]
+    fn a_performance_counts_its_pushes_out_of_the_noise() {
+        // A 2 mm tremor ripples a carry's one sweep: counted raw, the ripple makes pushes of
+        // its own; at the quiet level fewer, and never more.
+        let (mut raw, mut quiet) = (0, 0);
+        for seed in 1..=8 {
+            let carry = handled(1, 0.0005, 0.002, seed);
+            let (r, q) = (counted(&carry, 0.0), counted(&carry, EVENT_MARGIN));
+            assert!((1..=r).contains(&q), "seed {seed}: {q}, raw {r}");
+            raw += u32::from(r);
+            quiet += u32::from(q);
+        }
+        assert!(quiet + 3 <= raw, "{quiet} pushes counted, raw {raw}");
+        // Three pushes under the same noise are three, and a clean carry one, either way.
+        for seed in 1..=8 {
+            assert!(counted(&handled(3, 0.0005, 0.002, seed), EVENT_MARGIN) >= 3);
+        }
+        assert_eq!(counted(&handled(1, 0.0, 0.0, 1), EVENT_MARGIN), 1);
+        assert_eq!(counted(&handled(1, 0.0, 0.0, 1), 0.0), 1);
     }
 }

@@ -12,11 +12,12 @@
 //! | [`Sweeps::peaks`] | the speed, while moving, rises back to 1/[`PEAK_DROP`] of the least since the last peak fell to [`PEAK_DROP`] of itself | a push of the hand |
 //! | [`Sweeps::bobs`] | the vertical speed rises above [`BOB_SHARE`] of the speed, then falls below −[`BOB_SHARE`] of it | a stride at a steady speed: a person's pelvis glides, but bobs twice a gait cycle |
 //!
-//! A motion's count is the more of the two ([`Sweeps::count`]). Each action learns the fewest
-//! any of its examples made, counted against the tracker's noise (a rise or a dip counts only
-//! when it also exceeds [`LEARN_MARGIN`] × the learnt noise rms: what an example requires
-//! must stand out of the noise as its motion does), while an event's count is taken as the
-//! tracker gives it (generous in what it accepts). The decision stage refuses a new event
+//! A motion's count is the more of the two ([`Sweeps::count`]). A rise or a dip counts only
+//! when it also stands out of the tracker's learnt noise: for an action's examples, which set
+//! what a performance must make, by [`LEARN_MARGIN`] × the noise rms, as far as motion itself
+//! must; for a performance, by [`EVENT_MARGIN`] × the rms, the front end's quiet level, so that
+//! a ripple the noise puts on a carry's one sweep is no second push. Each action learns the
+//! fewest any of its examples made. The decision stage refuses a new event
 //! when the motion around it, from rest to rest, was [`one_sweep`], its action's examples
 //! each made [`MANY_SWEEPS`] or more, and its match cost at most [`SWEEP_COST`] (its pattern
 //! as written, bar one near token): a match that needed an edit may have left out the very
@@ -42,6 +43,12 @@ pub const BOB_SHARE: f32 = 0.15;
 /// sub-movement must also make to count: as far out of the noise as the front end's own
 /// hysteresis ([`crate::noise::ON_FACTOR`]) asks of motion.
 pub const LEARN_MARGIN: f32 = 2.5;
+/// Rise or dip, in units of the learnt translation noise rms (m/s), that a performance's
+/// sub-movement must also make to count: the front end's quiet level
+/// ([`crate::noise::QUIET_FACTOR`]), within which the figurine is at rest. Counted raw, the
+/// noise's ripple on a carry made a second peak, and the carry read as an action whose
+/// examples made several pushes.
+pub const EVENT_MARGIN: f32 = crate::noise::QUIET_FACTOR;
 /// Sub-movements every example of an action must have made for one sweep to be refused as
 /// that action: an action whose examples made two may be played as one push and its settling.
 pub const MANY_SWEEPS: u8 = 3;
