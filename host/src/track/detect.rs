@@ -4,9 +4,9 @@
 //!
 //! Not Debian's libapriltag 3.3.0: its worker pool lets a thread woken spuriously read a task
 //! while the next is being added, and the tasks' array may move under it (AprilRobotics/apriltag
-//! #339, fixed in 3.4): a test run of the host crashed with SIGSEGV inside a detection with two
-//! threads. Compiling the bundled source also keeps the library and the crate's generated
-//! bindings the same version.
+//! #339, fixed in 3.4), and one run of the host's tests died of SIGSEGV in the tracker's tests,
+//! which detect with two threads. Compiling the bundled source also keeps the library and the
+//! crate's generated bindings the same version.
 //!
 //! What the wrapper relies on, from `apriltag.h`/`apriltag_pose.h`:
 //! * a detector owns no family: the family must outlive it, so [`Detector`] drops the
