@@ -268,6 +268,7 @@ fn eval_over_seed_pairs_prints_each_pair_and_the_mean() {
     let mean = (pct(rows[0][3]) + pct(rows[1][3])) / 2.0;
     assert!((pct(rows[2][1]) - mean).abs() < 0.06, "{text}");
     assert!(text.contains("range: isolated"), "{text}");
+    assert!(text.contains("counts over the pairs: isolated "), "{text}");
 
     // Pairs learn anew: a given library is refused, with the reason.
     let out = figurine(&["eval", "--pairs", "2", "--library", "lib.json"]);

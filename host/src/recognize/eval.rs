@@ -188,6 +188,33 @@ pub struct Figures {
     /// Per kind of handling that plays no action ([`Handling`]): (name, events reported,
     /// logs with any event, logs).
     pub handling: Vec<(String, usize, usize, usize)>,
+    /// The counts behind the effort accuracies.
+    pub effort_counts: EffortCounts,
+}
+
+/// How many correctly recognised isolated gestures there were, and of them how many had their
+/// Time, their Weight and both right: the counts behind [`Figures::time`] and its kin. A mean
+/// accuracy can fall only because one more gesture is recognised; the counts tell.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EffortCounts {
+    /// Isolated gestures recognised as the action played.
+    pub read: usize,
+    /// Of them, Time right.
+    pub time: usize,
+    /// Weight right.
+    pub weight: usize,
+    /// Both right.
+    pub state: usize,
+}
+
+impl EffortCounts {
+    /// Adds `o`'s counts.
+    pub fn add(&mut self, o: EffortCounts) {
+        self.read += o.read;
+        self.time += o.time;
+        self.weight += o.weight;
+        self.state += o.state;
+    }
 }
 
 impl Figures {
@@ -284,6 +311,12 @@ pub fn evaluate(
     f.time = t_ok as f64 / eff_n.max(1) as f64;
     f.weight = w_ok as f64 / eff_n.max(1) as f64;
     f.state = s_ok as f64 / eff_n.max(1) as f64;
+    f.effort_counts = EffortCounts {
+        read: eff_n,
+        time: t_ok,
+        weight: w_ok,
+        state: s_ok,
+    };
     f.confusions = conf.into_iter().map(|((a, b), c)| (a, b, c)).collect();
     // Handling: any event is a false one.
     for (hi, &kind) in Handling::ALL.iter().enumerate() {

@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Result};
 
-use super::eval::{evaluate, prepare, quantiles, EvalArgs, Figures};
+use super::eval::{evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures};
 
 /// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
 pub const TEST_SEED_STEP: u64 = 1000;
@@ -57,6 +57,52 @@ impl PairLine {
     }
 }
 
+/// The counts under the pairs' shares, summed over the pairs: what a mean of percentages
+/// hides (one more gesture read moves every effort share).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Tally {
+    /// Isolated gestures read as the action played.
+    pub isolated_ok: usize,
+    /// Isolated gestures played.
+    pub isolated: usize,
+    /// The effort of those read.
+    pub effort: EffortCounts,
+    /// Handling logs given no event.
+    pub silent: usize,
+    /// Handling logs.
+    pub handling: usize,
+}
+
+impl Tally {
+    /// Adds one evaluation's counts.
+    pub fn add(&mut self, f: &Figures) {
+        for (_, ok, n) in &f.per_action {
+            self.isolated_ok += ok;
+            self.isolated += n;
+        }
+        self.effort.add(f.effort_counts);
+        for (_, _, loud, n) in &f.handling {
+            self.silent += n - loud.min(n);
+            self.handling += n;
+        }
+    }
+
+    /// One line: `counts over the pairs: …`.
+    pub fn line(&self) -> String {
+        format!(
+            "counts over the pairs: isolated {} of {} read as played, of them Time right {}, \
+             Weight {}, both {}; handling silent on {} of {} logs",
+            self.isolated_ok,
+            self.isolated,
+            self.effort.time,
+            self.effort.weight,
+            self.effort.state,
+            self.silent,
+            self.handling
+        )
+    }
+}
+
 /// Per field: mean, smallest, largest over `lines` (percent, latency in ms).
 pub fn summarise(lines: &[PairLine]) -> [(f64, f64, f64); 7] {
     let mut out = [(0.0, f64::INFINITY, f64::NEG_INFINITY); 7];
@@ -92,6 +138,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let knobs = args.knobs();
     let mut lines = Vec::new();
     let mut rows = Vec::new();
+    let mut tally = Tally::default();
     for i in 0..args.pairs as u64 {
         let pair = EvalArgs {
             seed: args.seed.wrapping_add(TEST_SEED_STEP.wrapping_mul(i)),
@@ -104,7 +151,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             ..*args
         };
         let (mut lib, effort) = prepare(&pair, &knobs)?;
-        let line = PairLine::of(&evaluate(&pair, &mut lib, effort, &knobs)?);
+        let figures = evaluate(&pair, &mut lib, effort, &knobs)?;
+        tally.add(&figures);
+        let line = PairLine::of(&figures);
         rows.push((pair.train_seed, pair.seed));
         lines.push(line);
     }
@@ -152,6 +201,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         s[6].1,
         s[6].2
     );
+    println!("{}", tally.line());
     Ok(())
 }
 
@@ -186,5 +236,39 @@ mod tests {
         assert!(close(s[2].1, 80.0) && close(s[2].2, 90.0));
         assert!(close(s[5].0, 150.0) && close(s[5].1, 140.0) && close(s[5].2, 160.0));
         assert!(close(s[6].0, 95.0) && close(s[6].1, 90.0));
+    }
+
+    #[test]
+    fn the_tally_sums_the_counts_under_the_shares() {
+        let f = |ok: usize, read: usize, loud: usize| Figures {
+            per_action: vec![("walk".into(), ok, 10), ("jump".into(), 10, 10)],
+            effort_counts: EffortCounts {
+                read,
+                time: read - 1,
+                weight: read - 2,
+                state: read - 3,
+            },
+            handling: vec![("lift".into(), 7, loud, 20)],
+            ..Figures::default()
+        };
+        let mut t = Tally::default();
+        t.add(&f(8, 18, 5));
+        t.add(&f(9, 19, 2));
+        assert_eq!((t.isolated_ok, t.isolated), (37, 40));
+        assert_eq!(
+            t.effort,
+            EffortCounts {
+                read: 37,
+                time: 35,
+                weight: 33,
+                state: 31
+            }
+        );
+        assert_eq!((t.silent, t.handling), (33, 40));
+        assert_eq!(
+            t.line(),
+            "counts over the pairs: isolated 37 of 40 read as played, of them Time right 35, \
+             Weight 33, both 31; handling silent on 33 of 40 logs"
+        );
     }
 }
