@@ -250,27 +250,17 @@ impl Frontend {
 mod tests {
     extern crate std;
     use super::*;
+    use crate::noise::tests::Noise;
     use core::f32::consts::PI;
     use std::vec::Vec;
-
-    /// Deterministic noise, uniform in [−1, 1] (xorshift32).
-    struct Noise(u32);
-
-    impl Noise {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            self.0 as f32 / u32::MAX as f32 * 2.0 - 1.0
-        }
-    }
 
     /// The toy moved 30 cm across in `pushes` minimum-jerk pushes over 0.8 s, lifted 4 cm and
     /// set down in each, after 2 s at rest and before 1.5 s more, at 120 Hz: a hand's 9 Hz
     /// tremor of `tremor` m along the motion (half as much up), each coordinate jittered
     /// uniformly by ±`jitter` m; the rest lets the front end learn that noise.
     fn handled(pushes: u32, jitter: f32, tremor: f32, seed: u32) -> Vec<Sample> {
-        let mut noise = Noise(seed);
+        let mut noise = Noise(u64::from(seed));
+        let mut jittered = move || jitter * (2.0 * noise.uniform() - 1.0);
         let n = pushes as f32;
         (0..(4.3 * 120.0) as u32)
             .map(|i| {
@@ -285,9 +275,9 @@ mod tests {
                     seq: i,
                     t_us: u64::from(i) * 1_000_000 / 120,
                     pos: [
-                        0.3 * reach + shake + jitter * noise.next(),
-                        1.0 + lift + 0.5 * shake + jitter * noise.next(),
-                        jitter * noise.next(),
+                        0.3 * reach + shake + jittered(),
+                        1.0 + lift + 0.5 * shake + jittered(),
+                        jittered(),
                     ],
                     quat: [1.0, 0.0, 0.0, 0.0],
                 }

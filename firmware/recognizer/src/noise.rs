@@ -407,15 +407,17 @@ impl NoiseFloor {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::intake::TICK_S;
 
-    /// Deterministic roughly-normal numbers (Irwin–Hall: twelve uniforms minus six).
-    struct Noise(u64);
+    /// Deterministic roughly-normal numbers (Irwin–Hall: twelve uniforms minus six); the other
+    /// modules' tests draw their noise from it too.
+    pub(crate) struct Noise(pub(crate) u64);
 
     impl Noise {
-        fn uniform(&mut self) -> f32 {
+        /// Uniform in [0, 1).
+        pub(crate) fn uniform(&mut self) -> f32 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;
