@@ -193,8 +193,8 @@ pub struct Figures {
 }
 
 /// How many correctly recognised isolated gestures there were, and of them how many had their
-/// Time, their Weight and both right: the counts behind [`Figures::time`] and its kin. A mean
-/// accuracy can fall only because one more gesture is recognised; the counts tell.
+/// Time, their Weight and both right: the counts behind [`Figures::time`] and its kin. An
+/// accuracy can fall merely because one more gesture is recognised; the counts tell.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct EffortCounts {
     /// Isolated gestures recognised as the action played.
