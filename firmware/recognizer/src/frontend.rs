@@ -132,9 +132,11 @@ impl Frontend {
             let step = self.tokenizer.step(&k);
             // After the step, the current token is the new one's (a TURN marker's rotation).
             let moving = self.tokenizer.current().is_some_and(|t| t != STILL);
-            let margin = margin * self.tokenizer.noise_rms().0;
+            let tokenizer = &self.tokenizer;
             // The speed is the features' own |world v| (one square root a tick, not two).
-            let began = self.sweep.step(q[SPEED], k.world_v[1], moving, margin);
+            let began = self.sweep.step(q[SPEED], k.world_v[1], moving, || {
+                margin * tokenizer.noise_rms().0
+            });
             // Only a tick that may belong to a STILL run is checked (none of a moving run's).
             let may_rest = self.tokenizer.current() == Some(STILL) || step != TokenStep::Run;
             let quiet = may_rest && self.tokenizer.quiet(&k);

@@ -98,28 +98,29 @@ impl SweepCounter {
     }
 
     /// One tick of `speed` and vertical speed `up` (m/s, world +Y), while `moving` (not STILL)
-    /// or not; a rise or dip must also exceed `margin` (m/s) to count. Returns what began on
-    /// this tick.
-    pub fn step(&mut self, speed: f32, up: f32, moving: bool, margin: f32) -> Sweeps {
+    /// or not; a rise or dip must also exceed `margin()` (m/s) to count. Returns what began on
+    /// this tick. The margin is asked for only when a rise or dip is otherwise enough (most
+    /// ticks need none: the noise rms behind it costs a square root).
+    pub fn step(&mut self, speed: f32, up: f32, moving: bool, margin: impl Fn() -> f32) -> Sweeps {
         let mut began = Sweeps::NONE;
         if self.in_peak {
             self.extreme = fmath::max(self.extreme, speed);
-            if speed <= PEAK_DROP * self.extreme && self.extreme - speed >= margin {
+            if speed <= PEAK_DROP * self.extreme && self.extreme - speed >= margin() {
                 self.in_peak = false;
                 self.extreme = speed;
             }
         } else {
             self.extreme = fmath::min(self.extreme, speed);
-            if moving && PEAK_DROP * speed >= self.extreme && speed - self.extreme >= margin {
+            if moving && PEAK_DROP * speed >= self.extreme && speed - self.extreme >= margin() {
                 self.in_peak = true;
                 self.extreme = speed;
                 began.peaks = 1;
             }
         }
         if moving {
-            if up > BOB_SHARE * speed && up > margin {
+            if up > BOB_SHARE * speed && up > margin() {
                 self.risen = true;
-            } else if -up > BOB_SHARE * speed && -up > margin && self.risen {
+            } else if -up > BOB_SHARE * speed && self.risen && -up > margin() {
                 self.risen = false;
                 began.bobs = 1;
             }
@@ -182,7 +183,7 @@ mod tests {
         for k in 0..n {
             let v = v(k as f32 * 0.01);
             let speed = fmath::norm3(v);
-            made.merge(c.step(speed, v[1], speed > crate::noise::V_FLOOR_M_S, margin));
+            made.merge(c.step(speed, v[1], speed > crate::noise::V_FLOOR_M_S, || margin));
         }
         made
     }
@@ -254,7 +255,7 @@ mod tests {
     fn still_ticks_begin_nothing() {
         let mut c = SweepCounter::new();
         for _ in 0..50 {
-            assert_eq!(c.step(0.54, 0.2, false, 0.0), Sweeps::NONE);
+            assert_eq!(c.step(0.54, 0.2, false, || 0.0), Sweeps::NONE);
         }
     }
 
