@@ -1,10 +1,13 @@
 //! The recognition commands end to end, as a user runs them: `synth` → `learn` →
 //! `train-effort` → `simulate`, plus the error a malformed log gives.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use figurine_host::events::read_events;
+
+mod scratch;
+use scratch::Scratch;
 
 fn figurine(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_figurine"))
@@ -13,11 +16,9 @@ fn figurine(args: &[&str]) -> Output {
         .unwrap()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("figurine-recog-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder unique to one test, removed when it passes.
+fn tmp(name: &str) -> Scratch {
+    Scratch::new("recog", name)
 }
 
 fn csvs(dir: &Path) -> Vec<String> {

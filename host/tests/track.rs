@@ -50,7 +50,6 @@ fn a_gesture_is_tracked_within_goals_and_reads_as_the_same_action() {
     );
     assert_eq!(run.truth_actions, vec!["sidestep".to_string()]);
     assert_eq!(run.tracked_actions, run.truth_actions);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -101,7 +100,6 @@ fn searching_near_the_tag_first_finds_the_same_poses_in_a_fraction_of_the_time()
         tb * 1e3,
         ta * 1e3
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A short path: still, then a slide to the figurine's left and a quarter turn.
@@ -187,7 +185,6 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
             "{line}"
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -218,7 +215,6 @@ fn print_tag_writes_png_and_pdf() {
         ]),
         &["tag36h11 has ids 0..587, not 9999"],
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -317,7 +313,6 @@ fn bad_input_gets_clear_errors() {
         ]),
         &["--tag-size"],
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -365,7 +360,6 @@ fn calibrate_finds_the_focal_length_and_tracking_uses_it() {
         (guessed - expected).abs() < 0.015,
         "{guessed} m vs {expected} m"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -452,5 +446,4 @@ fn a_camera_looking_down_is_measured_and_its_tilt_undone() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }

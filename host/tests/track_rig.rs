@@ -109,7 +109,6 @@ fn a_box_rig_is_tracked_at_every_heading_of_a_full_turn() {
         single.1 > 20 && single.0 > 3 * rig.0,
         "rig {rig:?}, one tag {single:?}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -154,7 +153,6 @@ fn a_fast_turn_stays_within_half_the_mirror_angle_at_every_frame() {
         .filter_map(|f| f.error.map(|e| (e.1, f.truth.t)))
         .fold((0.0, 0.0), |a: (f64, f64), b| if b.0 > a.0 { b } else { a });
     assert!(worst.0 < 11.0, "{:.1}° off at {:.2} s", worst.0, worst.1);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -299,7 +297,6 @@ fn the_cli_tracks_a_rig_prints_its_tags_and_refuses_bad_rigs() {
         ]),
         &["bad rig", "none.json"],
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -20,12 +20,13 @@ pub fn figurine() -> Command {
     c
 }
 
-/// A scratch folder unique to one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("figurine-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+#[path = "../scratch/mod.rs"]
+mod scratch;
+pub use scratch::Scratch;
+
+/// A scratch folder unique to one test, removed when it passes.
+pub fn scratch(name: &str) -> Scratch {
+    Scratch::new("cli", name)
 }
 
 /// Malformed contents, by name, written into `dir` with extension `ext`; plus a path that

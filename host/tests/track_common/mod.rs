@@ -16,11 +16,13 @@ pub fn figurine(args: &[&str]) -> Output {
         .expect("run figurine")
 }
 
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("figurine-track-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+#[path = "../scratch/mod.rs"]
+mod scratch;
+pub use scratch::Scratch;
+
+/// A scratch folder unique to one test, removed when it passes.
+pub fn scratch(name: &str) -> Scratch {
+    Scratch::new("track", name)
 }
 
 pub fn s(p: &Path) -> &str {
