@@ -3,12 +3,17 @@
 //! the generator. One evaluation is a few hundred generated gestures; which performances a
 //! draw happens to contain moves its figures by several points, more than many changes do.
 
+use std::collections::BTreeMap;
+
 use anyhow::{bail, Result};
 
 use super::eval::{evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures};
 
 /// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
 pub const TEST_SEED_STEP: u64 = 1000;
+
+/// Misreads [`Tally::misreads_line`] names, the most frequent first.
+pub const MISREADS_SHOWN: usize = 8;
 
 /// The figures of one pair, as printed: isolated, F1, Time, Weight, state (shares), median
 /// latency (s).
@@ -58,8 +63,9 @@ impl PairLine {
 }
 
 /// The counts under the pairs' shares, summed over the pairs: what a mean of percentages
-/// hides (one more gesture read moves every effort share).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// hides (one more gesture read moves every effort share), and which misreads make the
+/// isolated share (one pair's confusions are a handful; the pairs' sum shows a pattern).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Tally {
     /// Isolated gestures read as the action played.
     pub isolated_ok: usize,
@@ -71,6 +77,8 @@ pub struct Tally {
     pub silent: usize,
     /// Handling logs.
     pub handling: usize,
+    /// Isolated gestures by (action played, read as or "none"), read as another.
+    pub misreads: BTreeMap<(String, String), usize>,
 }
 
 impl Tally {
@@ -85,6 +93,31 @@ impl Tally {
             self.silent += n - loud.min(n);
             self.handling += n;
         }
+        for (played, read, n) in &f.confusions {
+            *self
+                .misreads
+                .entry((played.clone(), read.clone()))
+                .or_default() += n;
+        }
+    }
+
+    /// One line naming the [`MISREADS_SHOWN`] most frequent misreads over the pairs (ties by
+    /// name), or `None` when every isolated gesture was read as played.
+    pub fn misreads_line(&self) -> Option<String> {
+        let mut all: Vec<(&(String, String), &usize)> = self.misreads.iter().collect();
+        all.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+        let shown: Vec<String> = all
+            .iter()
+            .take(MISREADS_SHOWN)
+            .map(|((played, read), n)| format!("{played} -> {read} {n}"))
+            .collect();
+        (!shown.is_empty()).then(|| {
+            format!(
+                "most frequent misreads over the pairs: {} (of {} misread)",
+                shown.join(", "),
+                self.misreads.values().sum::<usize>()
+            )
+        })
     }
 
     /// One line: `counts over the pairs: …`.
@@ -202,6 +235,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         s[6].2
     );
     println!("{}", tally.line());
+    if let Some(line) = tally.misreads_line() {
+        println!("{line}");
+    }
     Ok(())
 }
 
@@ -249,6 +285,10 @@ mod tests {
                 state: read - 3,
             },
             handling: vec![("lift".into(), 7, loud, 20)],
+            confusions: vec![
+                ("walk".into(), "run".into(), 10 - ok),
+                ("jump".into(), "none".into(), 1),
+            ],
             ..Figures::default()
         };
         let mut t = Tally::default();
@@ -270,5 +310,13 @@ mod tests {
             "counts over the pairs: isolated 37 of 40 read as played, of them Time right 35, \
              Weight 33, both 31; handling silent on 33 of 40 logs"
         );
+        assert_eq!(
+            t.misreads_line().as_deref(),
+            Some(
+                "most frequent misreads over the pairs: walk -> run 3, jump -> none 2 \
+                 (of 5 misread)"
+            )
+        );
+        assert_eq!(Tally::default().misreads_line(), None);
     }
 }
