@@ -1,32 +1,53 @@
-//! A feature store whose record batch names a column buffer outside the batch's body (found by
-//! `cargo +nightly fuzz run graph_store`; kept as a fuzz seed) is refused with an error naming
-//! the file. The IPC decoder slices buffers unchecked: before, this input panicked inside it.
+//! Feature stores that fuzzing found to panic inside the Arrow IPC decoder (`cargo +nightly
+//! fuzz run graph_store`; each kept as a fuzz seed) are refused with an error naming the file:
+//! a record batch naming a column buffer outside its body (the decoder slices buffers
+//! unchecked), and one declaring a fixed-size list column longer than its body could hold
+//! (arrow-data multiplies that length by the list's width and panics on the overflow).
 
 use figurine_host::graph::store::{Store, BATCH_ROWS};
 use figurine_host::graph::WINDOW;
 
-#[test]
-fn a_buffer_outside_its_batch_is_an_error_naming_the_file() {
-    // The fuzz input: frame count (u32 LE), plan id (u64 LE), then the file's bytes.
-    let seed = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/fuzz/seeds/graph_store/buffer-outside-body.bin"
+/// Opens the store in fuzz seed `name` (frame count as u32 LE, plan id as u64 LE, then the
+/// file's bytes) and returns the errors of a tile's read and of the merge's.
+fn read_seed(name: &str) -> (String, String) {
+    let seed = format!(
+        "{}/fuzz/seeds/graph_store/{name}",
+        env!("CARGO_MANIFEST_DIR")
     );
     let data = std::fs::read(seed).unwrap();
     let frames = u32::from_le_bytes(data[..4].try_into().unwrap()) as usize % (2 * BATCH_ROWS + 1);
     let plan = u64::from_le_bytes(data[4..12].try_into().unwrap());
-    let dir = std::env::temp_dir().join(format!("figurine-store-corrupt-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!(
+        "figurine-store-corrupt-{}-{name}",
+        std::process::id()
+    ));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("features.arrow");
     std::fs::write(&path, &data[12..]).unwrap();
     let store = Store::open(&path, plan, frames).unwrap();
     let rows = store.rows(0..frames).unwrap_err().to_string();
+    let windows = (frames + 1).saturating_sub(WINDOW);
+    let lma = store.measurements(windows).unwrap_err().to_string();
+    let _ = std::fs::remove_dir_all(&dir);
+    (rows, lma)
+}
+
+#[test]
+fn a_buffer_outside_its_batch_is_an_error_naming_the_file() {
+    let (rows, lma) = read_seed("buffer-outside-body.bin");
     assert!(
         rows.contains("features.arrow") && rows.contains("outside its batch"),
         "{rows}"
     );
-    let windows = (frames + 1).saturating_sub(WINDOW);
-    let lma = store.measurements(windows).unwrap_err().to_string();
     assert!(lma.contains("features.arrow"), "{lma}");
-    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_column_longer_than_its_body_is_an_error_naming_the_file() {
+    let (rows, lma) = read_seed("column-longer-than-body.bin");
+    assert!(
+        rows.contains("features.arrow") && rows.contains("longer than its batch"),
+        "{rows}"
+    );
+    assert!(lma.contains("features.arrow"), "{lma}");
 }

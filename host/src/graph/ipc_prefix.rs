@@ -213,6 +213,18 @@ impl LeadingColumns {
         for buf in buffers.iter().flatten() {
             stop(buf)?;
         }
+        // Nor may a column be longer than its body could hold, a bit a value at the least
+        // (a validity bitmap): arrow-data multiplies a fixed-size list's length by its width
+        // unchecked against overflow and panics (arrow-data 60.1, `validate_child_data`).
+        let most = body_len.saturating_mul(8);
+        let fits = |n: i64| u64::try_from(n).is_ok_and(|n| n <= most);
+        let nodes = batch.nodes().map(|n| n.iter().collect::<Vec<_>>());
+        if !fits(batch.length()) || !nodes.iter().flatten().all(|n| fits(n.length())) {
+            return Err(err(
+                &self.path,
+                "a column is longer than its batch's body could hold",
+            ));
+        }
         match buffers {
             Some(b) if batch.compression().is_none() && b.len() == self.all_buffers => {
                 let mut end = 0u64;
