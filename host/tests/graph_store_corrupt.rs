@@ -32,22 +32,23 @@ fn read_seed(name: &str) -> (String, String) {
     (rows, lma)
 }
 
+/// The store in seed `name` is refused by a tile's read with an error naming the file and
+/// saying `why`, and by the merge's with one naming the file.
+fn refused(name: &str, why: &str) {
+    let (rows, lma) = read_seed(name);
+    assert!(
+        rows.contains("features.arrow") && rows.contains(why),
+        "{name}: {rows}"
+    );
+    assert!(lma.contains("features.arrow"), "{name}: {lma}");
+}
+
 #[test]
 fn a_buffer_outside_its_batch_is_an_error_naming_the_file() {
-    let (rows, lma) = read_seed("buffer-outside-body.bin");
-    assert!(
-        rows.contains("features.arrow") && rows.contains("outside its batch"),
-        "{rows}"
-    );
-    assert!(lma.contains("features.arrow"), "{lma}");
+    refused("buffer-outside-body.bin", "outside its batch");
 }
 
 #[test]
 fn a_column_longer_than_its_body_is_an_error_naming_the_file() {
-    let (rows, lma) = read_seed("column-longer-than-body.bin");
-    assert!(
-        rows.contains("features.arrow") && rows.contains("longer than its batch"),
-        "{rows}"
-    );
-    assert!(lma.contains("features.arrow"), "{lma}");
+    refused("column-longer-than-body.bin", "longer than its batch");
 }
