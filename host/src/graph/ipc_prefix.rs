@@ -218,8 +218,8 @@ impl LeadingColumns {
         // unchecked against overflow and panics (arrow-data 60.1, `validate_child_data`).
         let most = body_len.saturating_mul(8);
         let fits = |n: i64| u64::try_from(n).is_ok_and(|n| n <= most);
-        let nodes = batch.nodes().map(|n| n.iter().collect::<Vec<_>>());
-        if !fits(batch.length()) || !nodes.iter().flatten().all(|n| fits(n.length())) {
+        let mut nodes = batch.nodes().into_iter().flat_map(|n| n.iter());
+        if !fits(batch.length()) || !nodes.all(|n| fits(n.length())) {
             return Err(err(
                 &self.path,
                 "a column is longer than its batch's body could hold",
