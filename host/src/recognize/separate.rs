@@ -185,23 +185,14 @@ fn narrowings(re: &Regex) -> Vec<Regex> {
         .collect()
 }
 
-/// `entry` with pattern `re` (same name, bound, examples and shape); None when the device
-/// could not hold it.
+/// `entry` with pattern `re` and everything else its examples taught kept (name, bound,
+/// examples, shape, extent, travel, hold, sub-movements); None when the device could not hold
+/// it. Only the pattern changes: a narrowed kick still holds as long as its examples held.
 fn rewritten(entry: &ActionEntry, re: &Regex) -> Option<ActionEntry> {
-    ActionEntry::new(
-        &entry.name,
-        &re.to_source(),
-        Some(entry.max_edits),
-        entry.examples.clone(),
-    )
-    .ok()
-    .map(|e| {
-        let mut e = e.with_shape(entry.full_shape());
-        e.shape_tolerance = entry.shape_tolerance;
-        e.shape_spread = entry.shape_spread;
-        e.extent = entry.extent;
-        e
-    })
+    let mut e = entry.clone();
+    e.regex = re.to_source();
+    e.refresh().ok()?;
+    Some(e)
 }
 
 /// Every example of every action, as (action index, source text, tokens).
@@ -513,6 +504,47 @@ mod tests {
         );
         // Nothing left to separate: a second pass changes nothing.
         assert!(separate(&mut lib).unwrap().is_empty());
+    }
+
+    #[test]
+    fn a_narrowed_pattern_keeps_what_its_examples_taught() {
+        let mut lib = LibraryFile::default();
+        lib.upsert(entry("punch", "b* (f.Zn|f|f.Zp)+ b+", 1, &["b f b"]));
+        let mut kick = entry(
+            "kick",
+            "b* (f.Xn|f|f.Xp)+ (b.Xn|b|b.Xp)+ db*",
+            1,
+            &["b f.Xn b.Xp db", "f.Xn b.Xp", "b f.Xp b"],
+        )
+        .with_shape(Some([0.1, 0.3, 0.8, 1.2, 0.2, 0.1]))
+        .with_hold(Some(0.33))
+        .with_sweeps(Some(2));
+        kick.extent = Some([0.05, 0.34]);
+        kick.travel_m = Some(0.004);
+        kick.travel_share = Some(0.06);
+        kick.refresh().unwrap();
+        let before = kick.clone();
+        lib.upsert(kick);
+        assert_eq!(separate(&mut lib).unwrap().len(), 1);
+        let after = &lib.actions[1];
+        assert_ne!(after.regex, before.regex);
+        // Everything but the pattern (and its compiled form) is as learnt.
+        let unpatterned = |e: &ActionEntry| ActionEntry {
+            regex: String::new(),
+            compiled: None,
+            ..e.clone()
+        };
+        assert_eq!(unpatterned(after), unpatterned(&before));
+        // And the device reads them from the library's blob.
+        let blob = lib.blob().unwrap();
+        let dev = figurine_recognizer::pattern::Library::from_bytes(&blob).unwrap();
+        assert_eq!(dev.least_sweeps(1), 2);
+        assert!(
+            (320_000..=340_000).contains(&dev.hold_us(1)),
+            "{}",
+            dev.hold_us(1)
+        );
+        assert!(dev.extent(1).is_some_and(|e| e.travel_m > 0.0));
     }
 
     #[test]
