@@ -18,6 +18,11 @@
 //! - **its settling**: another action's match with under [`SETTLE_SHARE`] of the held event's
 //!   motion. A figurine that lands from a jump and gives at the knees (`d u`, a few
 //!   millimetres) has not crouched; nothing is reported.
+//! - **what it wound up for**: the settling's mirror — the held event was one stroke, under
+//!   [`SETTLE_SHARE`] of the match's motion, and went against the match's first stroke
+//!   ([`reversed`]). A dip before a jump, a counter-turn before a spin, a backswing before a
+//!   kick is the gesture's wind-up: the match takes the held event's place, from its start,
+//!   as a revision of it.
 //! - otherwise, a new event.
 //!
 //! Past [`CONTINUE_US`] the event stays held only as long as its action's examples held still
@@ -37,7 +42,7 @@ use crate::pattern::Library;
 #[cfg(doc)]
 use crate::segment::CONTINUE_US;
 use crate::segment::{edits_fit, Candidate, CONTINUE_GAP_RUNS};
-use crate::token::{Token, ARM_M, STILL};
+use crate::token::{token_signs, Token, ARM_M, STILL, TURN};
 
 /// Share of the held event's motion (path + [`ARM_M`] × angle) below which another action's
 /// match right after it is its settling, not an action. A jump's landing gives 2–5 cm against
@@ -74,6 +79,9 @@ pub(crate) enum Follow {
     Completes(u8),
     /// Its settling: nothing to report.
     Settles,
+    /// Its wind-up in reverse: the held event moved under [`SETTLE_SHARE`] of this match, which
+    /// takes its place (reported as a revision of it, from its start).
+    LeadsIn,
     /// A new event.
     New,
 }
@@ -92,6 +100,9 @@ pub(crate) fn follow(
 ) -> Follow {
     let mut tok = [STILL; HISTORY_RUNS];
     let (mut n, mut between, mut mine) = (0usize, 0usize, 0.0f32);
+    // The held event's stroke (TURN, which has no direction, when it made several) and `c`'s
+    // first.
+    let (mut held_last, mut c_first) = (STILL, STILL);
     // Moving tokens before `c`'s first.
     let mut before_c = 0usize;
     // A held event too long to read whole with what follows (a long walk) is read from its
@@ -112,8 +123,14 @@ pub(crate) fn follow(
         }
         match r {
             Some(r) => {
+                if moving && !after_h {
+                    held_last = if held_last == STILL { r.token } else { TURN };
+                }
                 if in_c {
                     mine += motion(&r.acc);
+                    if moving && c_first == STILL {
+                        c_first = r.token;
+                    }
                 }
                 if moving {
                     if !in_c {
@@ -173,11 +190,32 @@ pub(crate) fn follow(
             Follow::New
         };
     }
+    // A wind-up first: a held stroke that small is no action whose rest the match could be (a
+    // kick's backswing, read as a punch, is not completed by the kick).
     match cost {
+        _ if motion(&h.acc) < SETTLE_SHARE * mine && reversed(held_last, c_first) => {
+            Follow::LeadsIn
+        }
         Some(v) if v < h.cost.saturating_add(c.cost) => Follow::Completes(v),
         _ if mine < SETTLE_SHARE * motion(&h.acc) => Follow::Settles,
         _ => Follow::New,
     }
+}
+
+/// Whether stroke `a` is stroke `b` reversed: on every axis both move along (or turn about),
+/// they go opposite ways, and there is one — a dip before a rise (`d`, `u`), a backswing
+/// before a swing (`b`, `f`), a counter-turn before a spin (`.Yn`, `.Yp`).
+fn reversed(a: Token, b: Token) -> bool {
+    let ((al, ar), (bl, br)) = (token_signs(a), token_signs(b));
+    let mut opposite = false;
+    for (x, y) in al.iter().chain(&ar).zip(bl.iter().chain(&br)) {
+        match x * y {
+            1 => return false,
+            -1 => opposite = true,
+            _ => {}
+        }
+    }
+    opposite
 }
 
 /// Path length plus [`ARM_M`] × angle turned, as sums over ticks (÷ the tick rate, metres;
@@ -413,6 +451,58 @@ mod tests {
             follow(&lib, &hist, &h, &cand(1, o + 4, o + 5, false), false),
             Follow::New
         );
+    }
+
+    #[test]
+    fn a_small_stroke_against_the_action_after_it_is_its_wind_up() {
+        // 0 crouch `d+`, 1 jump `u+ d+`, 2 turn `.Yp+`, 3 bow `.Xp+ .Xn+`, 4 run `f+`.
+        let blob = seq_library(&[
+            (&["d"], 0),
+            (&["u", "d"], 0),
+            (&[".Yp"], 0),
+            (&[".Xp", ".Xn"], 0),
+            (&["f"], 0),
+        ]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let dip_then_jump = |dip: f32| history(&[("d", dip), ("_", 0.0), ("u", 20.0), ("d", 20.0)]);
+        // A 2 cm dip before a 40 cm jump: the jump's wind-up.
+        let (hist, o) = dip_then_jump(2.0);
+        let h = held(&hist, 0, o, o, 0);
+        let jump = cand(1, o + 2, o + 3, false);
+        assert_eq!(follow(&lib, &hist, &h, &jump, false), Follow::LeadsIn);
+        // As far as a fifth of the jump: a crouch of its own.
+        let (hist, o) = dip_then_jump(8.0);
+        let h = held(&hist, 0, o, o, 0);
+        assert_eq!(follow(&lib, &hist, &h, &jump, false), Follow::New);
+        // A small turn before a run is no wind-up: it does not go against the run's stroke.
+        let (hist, o) = history(&[(".Yp", 2.0), ("_", 0.0), ("f", 40.0)]);
+        let h = held(&hist, 2, o, o, 0);
+        let run = cand(4, o + 2, o + 2, false);
+        assert_eq!(follow(&lib, &hist, &h, &run, false), Follow::New);
+        // Nor is a whole bow, there and back, though it ends against the run's pitch.
+        let (hist, o) = history(&[(".Xp", 1.0), (".Xn", 1.0), ("_", 0.0), ("f.Xp", 40.0)]);
+        let h = held(&hist, 3, o, o + 1, 0);
+        let run = cand(4, o + 3, o + 3, false);
+        assert_eq!(follow(&lib, &hist, &h, &run, false), Follow::New);
+        // Nor anything after a longer stillness than the usual pause.
+        let (hist, o) = dip_then_jump(2.0);
+        let h = held(&hist, 0, o, o, 0);
+        assert_eq!(follow(&lib, &hist, &h, &jump, true), Follow::New);
+    }
+
+    #[test]
+    fn a_stroke_reversed_goes_the_other_way_on_every_axis_both_use() {
+        let t = |n: &str| parse_token(n).unwrap();
+        assert!(reversed(t("d"), t("u")));
+        assert!(reversed(t("b"), t("uf")));
+        assert!(reversed(t(".Yn"), t(".YpZn")));
+        assert!(reversed(t("d.Xp"), t("u")));
+        // One axis the same way: not reversed; no shared axis: not reversed.
+        assert!(!reversed(t("db"), t("df")));
+        assert!(!reversed(t("d"), t("f")));
+        assert!(!reversed(t(".Yp"), t("lb")));
+        assert!(!reversed(STILL, t("u")));
+        assert!(!reversed(crate::token::TURN, t("u")));
     }
 
     #[test]

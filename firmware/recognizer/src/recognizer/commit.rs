@@ -84,6 +84,14 @@ impl<'lib> Recognizer<'lib> {
         match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
             Follow::Settles => return Err(Why::Settles),
+            Follow::LeadsIn => {
+                return new(ev).map(|(mut ev, _, _)| {
+                    ev.start = h.start;
+                    ev.start_run = h.start_run;
+                    ev.acc.merge(&h.acc);
+                    (ev, true, Some(ev))
+                })
+            }
             Follow::Continues => h.distance = h.distance.max(c.distance()),
             Follow::Completes(cost) => {
                 h.cost = cost;
@@ -423,6 +431,63 @@ mod tests {
         // 30° there and back: a turn played small, but played.
         let ev = run(&lib, &twists(0.5, 0.06, Some(0.3)));
         assert_eq!(ev.len(), 1, "{ev:?}");
+    }
+
+    /// Still, a dip of `dip` m down in 0.4 s, held 0.3 s, then a jump: up 30 cm in 0.3 s and
+    /// down again in 0.3 s, then still; 200 Hz.
+    fn dip_then_jump(dip: f32) -> Vec<crate::intake::Sample> {
+        let rate = 200.0f32;
+        (0..(3.0 * rate) as u32)
+            .map(|i| {
+                let t = i as f32 / rate;
+                let y = 1.0 - dip * ramp((t - 0.5) / 0.4) + (dip + 0.3) * ramp((t - 1.2) / 0.3)
+                    - 0.3 * ramp((t - 1.5) / 0.3);
+                crate::intake::Sample {
+                    seq: i,
+                    t_us: (t * 1e6) as u64,
+                    pos: [0.3, y, 0.1],
+                    quat: [1.0, 0.0, 0.0, 0.0],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_dip_before_a_jump_is_the_jump_from_the_dip_on() {
+        // 0 "crouch" `d`, 1 "jump" `u d`.
+        let blob = seq_library(&[(&["d"], 0), (&["u", "d"], 0)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let folded = |ev: &[ActionEvent]| {
+            let mut out: Vec<ActionEvent> = Vec::new();
+            for e in ev {
+                match out.last_mut() {
+                    Some(last) if e.revises => *last = *e,
+                    _ => out.push(*e),
+                }
+            }
+            out
+        };
+        // A 4 cm dip is reported when the figurine pauses low, then taken into the jump.
+        let ev = run(&lib, &dip_then_jump(0.04));
+        assert_eq!(ev.first().map(|e| e.action), Some(0), "{ev:?}");
+        let one = folded(&ev);
+        assert_eq!(
+            one.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [1],
+            "{ev:?}"
+        );
+        assert!(
+            one[0].start_us <= 520_000 && one[0].end_us >= 1_750_000,
+            "{one:?}"
+        );
+        // A 25 cm dip is more than a fifth of the jump's 85 cm (rising from the dip, then
+        // landing): a crouch, then a jump.
+        let ev = run(&lib, &dip_then_jump(0.25));
+        assert_eq!(
+            folded(&ev).iter().map(|e| e.action).collect::<Vec<_>>(),
+            [0, 1],
+            "{ev:?}"
+        );
     }
 
     /// Still, then `pushes` strokes forward of 0.4 s and 10 cm each, the speed falling to
