@@ -10,6 +10,7 @@
 //! | [`Why::NotFarEnough`] | a new event that went less far (or, for an action whose examples travelled, ended less far away) than its action's examples allow: a fidget | [`crate::extent`] |
 //! | [`Why::OneSweep`] | a new event whose motion, from rest to rest, was one sweep, where its action's examples each made several pushes: a toy carried | [`crate::sweep`] |
 //! | [`Why::Settles`] | the settling of the event before it, which moved much more | [`crate::follow`] |
+//! | [`Why::WindUp`] | an event taken into the gesture after it: one stroke against that gesture's first, far smaller — its wind-up | [`crate::follow`] |
 //! | [`Why::Lost`] | its token runs had already left the history | [`crate::history`] |
 //! | [`Why::Reread`] | its motion was plainly unlike its action's examples: reported as the action it moved like | [`crate::nearest`] |
 //! | [`Why::Nearest`] | a stand-alone phrase no pattern matched closely: reported as its nearest action | [`crate::nearest`] |
@@ -29,6 +30,12 @@ pub enum Why {
     /// Dropped: a new event whose motion from rest to rest was one sweep, where each of its
     /// action's examples made several sub-movements.
     OneSweep,
+    /// Taken into the event of action `into` right after it, as that gesture's wind-up: one
+    /// stroke against its first, under a fifth of its motion.
+    WindUp {
+        /// The action whose event took it in.
+        into: u8,
+    },
     /// Dropped: the settling of the event before it.
     Settles,
     /// Dropped: its runs had left the history before it was committed.

@@ -406,6 +406,11 @@ pub fn why_words(n: &Note, names: &[String]) -> String {
              where each of `{action}`'s examples made {MANY_SWEEPS} or more (a toy carried)"
         ),
         Why::Settles => "dropped: the settling of the event before it".into(),
+        Why::WindUp { into } => format!(
+            "taken into the `{}` after it as its wind-up: one stroke the other way, under a \
+             fifth of its motion",
+            name_of(names, into)
+        ),
         Why::Lost => "dropped: its motion had left the recognizer's history".into(),
         Why::Reread { matched } => format!(
             "read as `{action}`: `{}`'s pattern matched, but it moved unlike its \

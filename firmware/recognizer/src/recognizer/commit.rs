@@ -226,6 +226,10 @@ impl<'lib> Recognizer<'lib> {
                 return;
             }
         };
+        if let Some(b) = before.filter(|b| revises && b.action != ev.action) {
+            // Only a wind-up revises the held event as another action.
+            out.note(|| Some(wound_up(&b, ev.action)));
+        }
         self.phrase_floor = (self.floor, false);
         self.held = held;
         match provisional {
@@ -263,6 +267,18 @@ impl<'lib> Recognizer<'lib> {
             revises,
         });
         self.events = self.events.saturating_add(1);
+    }
+}
+
+/// The note on held event `b`, taken into the event of action `into` as its wind-up.
+fn wound_up(b: &Held, into: u8) -> Note {
+    Note {
+        action: b.action,
+        start_seq: b.start.0,
+        start_us: b.start.1,
+        end_seq: b.end.0,
+        end_us: b.end.1,
+        why: Why::WindUp { into },
     }
 }
 
@@ -479,6 +495,15 @@ mod tests {
         assert!(
             one[0].start_us <= 520_000 && one[0].end_us >= 1_750_000,
             "{one:?}"
+        );
+        // `--why` says where the dip went.
+        let (_, notes) = run_noted(&lib, &dip_then_jump(0.04));
+        let wound = Why::WindUp { into: 1 };
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.action == 0 && n.why == wound && n.end_us < 1_100_000),
+            "{notes:?}"
         );
         // A 25 cm dip is more than a fifth of the jump's 85 cm (rising from the dip, then
         // landing): a crouch, then a jump.
