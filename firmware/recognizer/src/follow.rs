@@ -20,7 +20,7 @@
 //!   millimetres) has not crouched; nothing is reported.
 //! - **what it wound up for**: the settling's mirror — the held event was one stroke, under
 //!   [`SETTLE_SHARE`] of the match's motion, and went against the match's first stroke
-//!   ([`reversed`]). A dip before a jump, a counter-turn before a spin, a backswing before a
+//!   (`reversed`). A dip before a jump, a counter-turn before a spin, a backswing before a
 //!   kick is the gesture's wind-up: the match takes the held event's place, from its start,
 //!   as a revision of it.
 //! - otherwise, a new event.
@@ -79,8 +79,8 @@ pub(crate) enum Follow {
     Completes(u8),
     /// Its settling: nothing to report.
     Settles,
-    /// Its wind-up in reverse: the held event moved under [`SETTLE_SHARE`] of this match, which
-    /// takes its place (reported as a revision of it, from its start).
+    /// The held event was its wind-up (one stroke against its first, under [`SETTLE_SHARE`] of
+    /// its motion): the match takes its place, reported as a revision of it from its start.
     LeadsIn,
     /// A new event.
     New,

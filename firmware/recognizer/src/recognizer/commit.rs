@@ -44,7 +44,8 @@ impl<'lib> Recognizer<'lib> {
     }
 
     /// What committing `c` after the held event `held` emits — the event, and whether it
-    /// continues (revises) `held` — and the held event after it ([`crate::follow`]); or why
+    /// revises `held` (continues it, or takes it in as its wind-up) — and the held event after
+    /// it ([`crate::follow`]); or why
     /// there is none: `c` is too brief, is the held event's settling, or is a new event whose
     /// motion did not go as far as its action's examples ([`far_enough`]: a fidget).
     pub(super) fn outcome(
