@@ -1,7 +1,8 @@
 //! Flash and static RAM of a firmware ELF, read from its section headers (what
 //! `llvm-size -A` shows, summed the way a linker map would).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
 
 use anyhow::{bail, Context, Result};
 
@@ -24,6 +25,39 @@ fn u16_at(b: &[u8], at: usize) -> Option<u16> {
 
 fn u32_at(b: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+}
+
+/// The firmware's source folders, relative to the workspace root: what an image is built from.
+pub const FIRMWARE_SOURCES: [&str; 5] = [
+    "firmware/recognizer/src",
+    "firmware/app/src",
+    "firmware/fpu/src",
+    "firmware/store/src",
+    "protocol/src",
+];
+
+/// A firmware source file (under [`FIRMWARE_SOURCES`] of workspace `root`) changed after the
+/// image `elf` was built, if any: the image's figures are then not the sources' (the benches
+/// read whatever image the last `cargo xtask firmware` left). None when the image or every
+/// source is older, or a time cannot be read.
+pub fn newer_source(root: &Path, elf: &Path) -> Option<PathBuf> {
+    let built = std::fs::metadata(elf).and_then(|m| m.modified()).ok()?;
+    let mut stack: Vec<PathBuf> = FIRMWARE_SOURCES.iter().map(|d| root.join(d)).collect();
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if modified(&path).is_some_and(|t| t > built) {
+                return Some(path);
+            }
+        }
+    }
+    None
+}
+
+fn modified(path: &Path) -> Option<SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
 /// Sizes of a 32-bit little-endian ELF (all Cortex-M images are).
@@ -69,5 +103,27 @@ mod tests {
         std::fs::write(&dir, b"hello").unwrap();
         assert!(image_size(&dir).is_err());
         std::fs::remove_file(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_source_changed_after_the_image_is_named() {
+        use std::time::Duration;
+        let root = std::env::temp_dir().join(format!("fig-stale-{}", std::process::id()));
+        let src = root.join("firmware/recognizer/src/deep");
+        std::fs::create_dir_all(&src).unwrap();
+        let (elf, rs) = (root.join("image.elf"), src.join("follow.rs"));
+        let at = |path: &Path, secs: u64| {
+            let f = std::fs::File::create(path).unwrap();
+            f.set_modified(SystemTime::UNIX_EPOCH + Duration::from_secs(secs))
+                .unwrap();
+        };
+        at(&rs, 1_000);
+        at(&elf, 2_000);
+        assert_eq!(newer_source(&root, &elf), None);
+        at(&rs, 3_000);
+        assert_eq!(newer_source(&root, &elf), Some(rs));
+        // No image: nothing to call stale.
+        assert_eq!(newer_source(&root, &root.join("missing.elf")), None);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }

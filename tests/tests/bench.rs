@@ -16,7 +16,7 @@ use std::sync::OnceLock;
 use std::time::Duration;
 
 use figurine_e2e::defmt_log::{cycle_reports, decode};
-use figurine_e2e::elf::image_size;
+use figurine_e2e::elf::{image_size, newer_source};
 use figurine_e2e::{firmware_elf, Qemu, QemuOptions};
 use figurine_host::link::blobs::{self, Blobs};
 use figurine_host::link::cli::upload_to;
@@ -31,6 +31,18 @@ use figurine_recognizer::EffortModel;
 
 /// Emulated instructions per SysTick cycle under `-icount shift=0` (1 GHz / 25 MHz).
 const INSNS_PER_CYCLE: u64 = 40;
+
+/// A warning when a firmware source changed after image `elf` was built (empty otherwise).
+fn stale(elf: &Path) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    newer_source(&root, elf).map_or_else(String::new, |src| {
+        format!(
+            "\n  STALE: {} changed after this image was built; `cargo xtask firmware --board \
+             qemu` (and `--board nrf52840`) rebuild it",
+            src.strip_prefix(&root).unwrap_or(&src).display()
+        )
+    })
+}
 
 fn nrf_elf() -> PathBuf {
     std::env::var_os("FIGURINE_NRF_ELF").map_or_else(
@@ -79,15 +91,16 @@ fn figure_image_sizes() {
         ("qemu mps2-an386", firmware_elf().ok()),
         ("nrf52840", Some(nrf_elf()).filter(|p| p.is_file())),
     ] {
-        match elf.map(|p| image_size(&p)) {
-            Some(Ok(s)) => println!(
-                "  {board:<16} flash {:>7} B ({:.1} KiB)   static RAM {:>6} B ({:.1} KiB)",
+        match elf.as_deref().map(|p| (image_size(p), p)) {
+            Some((Ok(s), p)) => println!(
+                "  {board:<16} flash {:>7} B ({:.1} KiB)   static RAM {:>6} B ({:.1} KiB){}",
                 s.flash,
                 s.flash as f64 / 1024.0,
                 s.static_ram,
-                s.static_ram as f64 / 1024.0
+                s.static_ram as f64 / 1024.0,
+                stale(p)
             ),
-            Some(Err(e)) => println!("  {board:<16} {e}"),
+            Some((Err(e), _)) => println!("  {board:<16} {e}"),
             None => println!("  {board:<16} not built (cargo xtask firmware --board ...)"),
         }
     }
@@ -100,8 +113,9 @@ fn figure_instructions_per_sample() {
     let log = bench_log();
     println!(
         "recognizer instructions per pose sample, Cortex-M4F in QEMU -icount shift=0 \
-         ({} samples of a synthetic 4-action sequence; goal <= 5000 at 32 actions)",
-        log.samples.len()
+         ({} samples of a synthetic 4-action sequence; goal <= 5000 at 32 actions){}",
+        log.samples.len(),
+        stale(&elf)
     );
     for n in [1usize, 8, 32] {
         let blobs = blobs_with(n);
