@@ -26,10 +26,10 @@
 //! - otherwise, a new event.
 //!
 //! Past [`CONTINUE_US`] the event stays held only as long as its action's examples held still
-//! inside ([`Library::hold_us`]: a crouch held low, then risen from), and only its rest may
-//! then follow it: another action's match over which the held action's pattern costs no more
-//! than the two apart, and which alone is not the held action again — a repetition after a
-//! hold is a new event.
+//! inside ([`Library::hold_us`]: a crouch held low, then risen from), and only what it wound up
+//! for or its rest may then follow it — its rest being another action's match over which the
+//! held action's pattern costs no more than the two apart, and which alone is not the held
+//! action again: a repetition after a hold is a new event.
 //!
 //! Motion is measured as path length plus [`ARM_M`] × the angle turned, so that a wave or a
 //! turn (much rotation, little path) is not mistaken for a settling. Everything here runs at
@@ -167,6 +167,13 @@ pub(crate) fn follow(
             })
     };
     let cost = held_cost(0);
+    // A wind-up first, whenever the event is still held: a held stroke that small is no
+    // action whose rest the match could be (a kick's backswing, read as a punch, is not
+    // completed by the kick).
+    if h.action != c.action && motion(&h.acc) < SETTLE_SHARE * mine && reversed(held_last, c_first)
+    {
+        return Follow::LeadsIn;
+    }
     if late {
         // After a longer stillness than any pause inside an action: only what finishes a
         // hold its action's examples made, never a repetition of the held action.
@@ -190,12 +197,7 @@ pub(crate) fn follow(
             Follow::New
         };
     }
-    // A wind-up first: a held stroke that small is no action whose rest the match could be (a
-    // kick's backswing, read as a punch, is not completed by the kick).
     match cost {
-        _ if motion(&h.acc) < SETTLE_SHARE * mine && reversed(held_last, c_first) => {
-            Follow::LeadsIn
-        }
         Some(v) if v < h.cost.saturating_add(c.cost) => Follow::Completes(v),
         _ if mine < SETTLE_SHARE * motion(&h.acc) => Follow::Settles,
         _ => Follow::New,
@@ -484,10 +486,11 @@ mod tests {
         let h = held(&hist, 3, o, o + 1, 0);
         let run = cand(4, o + 3, o + 3, false);
         assert_eq!(follow(&lib, &hist, &h, &run, false), Follow::New);
-        // Nor anything after a longer stillness than the usual pause.
+        // After a longer stillness than the usual pause, held by its action's learnt hold
+        // (a crouch held low), it is a wind-up all the same.
         let (hist, o) = dip_then_jump(2.0);
         let h = held(&hist, 0, o, o, 0);
-        assert_eq!(follow(&lib, &hist, &h, &jump, true), Follow::New);
+        assert_eq!(follow(&lib, &hist, &h, &jump, true), Follow::LeadsIn);
     }
 
     #[test]
