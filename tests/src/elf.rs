@@ -41,7 +41,7 @@ pub const FIRMWARE_SOURCES: [&str; 5] = [
 /// read whatever image the last `cargo xtask firmware` left). None when the image or every
 /// source is older, or a time cannot be read.
 pub fn newer_source(root: &Path, elf: &Path) -> Option<PathBuf> {
-    let built = std::fs::metadata(elf).and_then(|m| m.modified()).ok()?;
+    let built = modified(elf)?;
     let mut stack: Vec<PathBuf> = FIRMWARE_SOURCES.iter().map(|d| root.join(d)).collect();
     while let Some(dir) = stack.pop() {
         for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {

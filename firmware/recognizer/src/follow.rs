@@ -166,7 +166,6 @@ pub(crate) fn follow(
                 weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, len))
             })
     };
-    let cost = held_cost(0);
     // A wind-up first, whenever the event is still held: a held stroke that small is no
     // action whose rest the match could be (a kick's backswing, read as a punch, is not
     // completed by the kick).
@@ -174,6 +173,7 @@ pub(crate) fn follow(
     {
         return Follow::LeadsIn;
     }
+    let cost = held_cost(0);
     if late {
         // After a longer stillness than any pause inside an action: only what finishes a
         // hold its action's examples made, never a repetition of the held action.
