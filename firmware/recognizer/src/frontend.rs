@@ -347,9 +347,9 @@ mod tests {
 
     #[test]
     fn a_hands_tremor_is_not_learnt_as_the_trackers_noise() {
-        // 1.5 mm of tremor reads as 8 cm/s of motion at its peaks; notched, it adds a fifth
-        // of that to the jitter's floor at 120 Hz. A 30 Hz tracker is read as it is, tremor
-        // and all (the learnt rms triples).
+        // 1.5 mm of tremor reads as 8 cm/s of motion at its peaks; notched, it adds under
+        // 1 cm/s to the jitter's learnt rms at 120 Hz. A 30 Hz tracker is read as it is,
+        // tremor and all: there the learnt rms triples.
         let (quiet, shaking) = (rest_noise(120, 0.0), rest_noise(120, 0.0015));
         assert!(shaking < 2.0 * quiet, "{shaking} against {quiet}");
         let (quiet, shaking) = (rest_noise(30, 0.0), rest_noise(30, 0.0015));
