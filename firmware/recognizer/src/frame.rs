@@ -46,7 +46,11 @@ fn pick(d: &[f32; 7], off: usize) -> [f32; 4] {
 
 /// Computes the object-frame kinematics of a filtered tick.
 pub fn kinematics(s: &Smoothed) -> Kinematics {
-    let (q, qu, inv_n2) = orientation(s);
+    let q = pick(&s.d[0], 3);
+    let n2 = fmath::qdot(q, q);
+    let inv_n2 = if n2 > 1e-12 { 1.0 / n2 } else { 1.0 };
+    let inv_n = fmath::sqrt(inv_n2);
+    let qu = [q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n];
     let qd = pick(&s.d[1], 3);
     let qdd = pick(&s.d[2], 3);
     let qddd = pick(&s.d[3], 3);
@@ -70,36 +74,6 @@ pub fn kinematics(s: &Smoothed) -> Kinematics {
         world_v,
         world_a,
         world_j,
-    }
-}
-
-/// The filtered orientation `q`, its unit version and 1 / |q|².
-fn orientation(s: &Smoothed) -> ([f32; 4], [f32; 4], f32) {
-    let q = pick(&s.d[0], 3);
-    let n2 = fmath::qdot(q, q);
-    let inv_n2 = if n2 > 1e-12 { 1.0 / n2 } else { 1.0 };
-    let inv_n = fmath::sqrt(inv_n2);
-    (
-        q,
-        [q[0] * inv_n, q[1] * inv_n, q[2] * inv_n, q[3] * inv_n],
-        inv_n2,
-    )
-}
-
-impl Kinematics {
-    /// These kinematics with the velocities (`v`, `w`, `world_v`) taken from `d1`, other
-    /// first derivatives of the channels of `s` (the tick they were computed from): the same
-    /// motion with the hand's tremor notched out ([`crate::tremor`]). Accelerations and jerks
-    /// stay as they were.
-    pub fn with_velocity(&self, s: &Smoothed, d1: &[f32; 7]) -> Kinematics {
-        let (q, qu, inv_n2) = orientation(s);
-        let world_v = [d1[0], d1[1], d1[2]];
-        Kinematics {
-            v: fmath::rotate_inv(qu, world_v),
-            w: vec_part(fmath::qmul(fmath::qconj(q), pick(d1, 3)), inv_n2),
-            world_v,
-            ..*self
-        }
     }
 }
 
@@ -143,35 +117,6 @@ mod tests {
             assert!(k.v[0].abs() < 1e-3 && k.v[1].abs() < 1e-3);
             assert!(fmath::norm3(k.w) < 1e-3);
         }
-    }
-
-    #[test]
-    fn other_velocities_replace_only_the_velocities() {
-        let mut sg = SavGol::new();
-        let mut last = None;
-        for i in 0..20u64 {
-            let t = i as f32 * TICK_S;
-            let tick = Tick {
-                t_us: i * 10_000,
-                pos: [0.2 * t, 0.1 * t * t, 0.0],
-                quat: yaw(1.5 * t),
-                seq: i as u32,
-                sample_t_us: i * 10_000,
-            };
-            last = sg.push(tick).or(last);
-        }
-        let s = last.unwrap();
-        let k = kinematics(&s);
-        // The same velocities give the same kinematics, to the bit.
-        assert_eq!(k.with_velocity(&s, &s.d[1]), k);
-        // Halved, the velocities halve; accelerations and jerks stay.
-        let half = s.d[1].map(|v| 0.5 * v);
-        let h = k.with_velocity(&s, &half);
-        for i in 0..3 {
-            assert!((h.v[i] - 0.5 * k.v[i]).abs() < 1e-6, "{:?} {:?}", h.v, k.v);
-            assert!((h.w[i] - 0.5 * k.w[i]).abs() < 1e-5, "{:?} {:?}", h.w, k.w);
-        }
-        assert_eq!((h.a, h.j, h.wa, h.world_a), (k.a, k.j, k.wa, k.world_a));
     }
 
     #[test]

@@ -8,8 +8,7 @@
 //!
 //! Stages, one module each, in data-flow order:
 //! [`intake`] (validate, resample to 100 Hz) → [`filter`] (Savitzky–Golay) → [`frame`]
-//! (object-frame velocities; a hand's tremor notched out of them where it would set the
-//! floor: [`tremor`]) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
+//! (object-frame velocities) → [`token`] (27×27 + STILL) → [`pattern`] (compiled regexes) →
 //! [`automaton`] (bit-parallel Levenshtein automata, edits weighted by [`alignment`]: near
 //! tokens cost half; a match's motion against its action's: [`shape`]) → [`segment`] (online
 //! decision; stand-alone gestures no action matched given to their [`nearest`] action; a
@@ -68,7 +67,6 @@ pub mod segment;
 pub mod shape;
 pub mod sweep;
 pub mod token;
-pub mod tremor;
 
 pub use bayes::EffortModel;
 pub use intake::Sample;
