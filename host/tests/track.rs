@@ -181,7 +181,7 @@ fn the_cli_renders_tracks_and_draws_the_overlay() {
     assert_eq!(piped.samples.len(), tracked.samples.len());
     for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
         assert!(
-            figurine_host::link::live::parse_pose_line(line).is_some(),
+            figurine_host::link::lines::parse_pose_line(line).is_some(),
             "{line}"
         );
     }

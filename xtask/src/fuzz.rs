@@ -113,6 +113,28 @@ const TARGETS: &[Target] = &[
         real_seeds: &[],
         max_len: 96 * 1024,
     },
+    // Seed (host/fuzz/seeds/): a tracked stream's lines with a header and a comment.
+    Target {
+        dir: "host/fuzz",
+        name: "pose_lines",
+        real_seeds: &[],
+        max_len: 0,
+    },
+    // Seeds (host/fuzz/seeds/): the box rig with its top tag, then a calibration.
+    Target {
+        dir: "host/fuzz",
+        name: "track_files",
+        real_seeds: &[],
+        max_len: 0,
+    },
+    // Seed (host/fuzz/seeds/): a two-clip graph file with its edges (written by `graph::graph`'s
+    // tests with FIGURINE_WRITE_FUZZ_SEEDS=1).
+    Target {
+        dir: "host/fuzz",
+        name: "graph_file",
+        real_seeds: &[],
+        max_len: 0,
+    },
     Target {
         dir: "firmware/recognizer/fuzz",
         name: "sample_feed",

@@ -278,6 +278,11 @@ impl MotionGraph {
             path: path.to_path_buf(),
             source,
         })?;
+        Self::from_bytes(&bytes, path)
+    }
+
+    /// Decodes the bytes of graph file `path` (named in errors).
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<MotionGraph, GraphError> {
         let body = bytes.strip_prefix(MAGIC.as_slice()).ok_or_else(|| {
             GraphError::format(path, "not a figurine graph file (no FIGGRAPH header)")
         })?;
@@ -292,12 +297,31 @@ impl MotionGraph {
                 ),
             ));
         }
+        // The clips tile the global frames from 0, in order: every frame lookup relies on it.
+        let mut next = 0u32;
+        for (k, c) in g.clips.iter().enumerate() {
+            if c.start != next {
+                return Err(GraphError::format(
+                    path,
+                    format!(
+                        "inconsistent graph file (clip {} starts at frame {}, not {next})",
+                        k + 1,
+                        c.start
+                    ),
+                ));
+            }
+            next = next.checked_add(c.frames).ok_or_else(|| {
+                GraphError::format(path, "inconsistent graph file (more than 2³² frames)")
+            })?;
+        }
         let windows: usize = g
             .clips
             .iter()
             .map(|c| (c.frames as usize + 1).saturating_sub(WINDOW))
             .sum();
         if g.measurements.len() != windows * MEASUREMENTS
+            || g.standardiser.mean.len() != MEASUREMENTS
+            || g.standardiser.std.len() != MEASUREMENTS
             || g.edges
                 .iter()
                 .any(|e| e.to as usize >= g.frames() || e.from as usize >= g.frames())
@@ -465,6 +489,60 @@ pub(crate) mod tests {
             .to_string()
             .contains("corrupt"));
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A graph file whose sizes disagree is refused with the file's name, before anything
+    /// indexes by them: clips that do not tile the frames from 0 (a frame count past 2³² made
+    /// `graph synth` overflow, found by the `graph_file` fuzz target), or a standardiser of
+    /// another length than the measurements.
+    #[test]
+    fn a_graph_whose_sizes_disagree_is_refused() {
+        let path = Path::new("G.bin");
+        let bytes = |g: &MotionGraph| {
+            let mut b = MAGIC.to_vec();
+            b.extend(postcard::to_allocvec(g).unwrap());
+            b
+        };
+        let good = toy_graph(vec![e(20, 45, 0.9)], &[50, 40]);
+        assert!(MotionGraph::from_bytes(&bytes(&good), path).is_ok());
+        let mut gap = good.clone();
+        gap.clips[1].start = 60;
+        let mut past = good.clone();
+        past.clips[1].frames = u32::MAX;
+        let mut short = good.clone();
+        short.standardiser.std.pop();
+        for (g, why) in [
+            (gap, "clip 2 starts at frame 60, not 50"),
+            (past, "2³²"),
+            (short, "sizes"),
+        ] {
+            let e = MotionGraph::from_bytes(&bytes(&g), path)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("G.bin") && e.contains(why), "{e}");
+        }
+    }
+
+    /// The seed of the `graph_file` fuzz target: a two-clip graph with edges within and
+    /// between the clips. Written again with FIGURINE_WRITE_FUZZ_SEEDS=1 (after a change of
+    /// the format).
+    #[test]
+    fn the_fuzz_seed_is_a_graph_the_reader_accepts() {
+        let seed =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/graph_file/two-clips.bin");
+        let g = toy_graph(
+            vec![e(20, 45, 0.9), e(25, 60, 0.8), e(40, 70, 0.2)],
+            &[50, 40],
+        );
+        if std::env::var_os("FIGURINE_WRITE_FUZZ_SEEDS").is_some() {
+            let mut bytes = MAGIC.to_vec();
+            bytes.extend(postcard::to_allocvec(&g).unwrap());
+            std::fs::create_dir_all(seed.parent().unwrap()).unwrap();
+            std::fs::write(&seed, bytes).unwrap();
+        }
+        let read = MotionGraph::from_bytes(&std::fs::read(&seed).unwrap(), &seed).unwrap();
+        assert_eq!(read, g);
+        assert_eq!(read.count(Variant::Mg, None, None), 3);
     }
 
     #[test]

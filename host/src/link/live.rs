@@ -13,7 +13,7 @@
 //!   the time from event arrival to its first presented frame is reported.
 
 use std::fs::File;
-use std::io::{BufRead, BufWriter, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Sender;
@@ -25,6 +25,7 @@ use clap::Args;
 use figurine_protocol::{HostToDevice, Pose};
 
 use super::blobs;
+use super::lines::{PoseLines, MAX_LINE_BYTES};
 use super::replay::record_with_times;
 use super::{Device, PortSpec};
 use crate::events::{event_line, ActionRecord};
@@ -66,25 +67,6 @@ pub struct LiveArgs {
     pub quit_after: Option<f64>,
 }
 
-/// Parses one pose CSV data line (`t,x,y,z,qw,qx,qy,qz[,…]`); `None` for a header, a
-/// comment, a blank or malformed line.
-pub fn parse_pose_line(line: &str) -> Option<PoseSample> {
-    let line = line.trim();
-    if line.is_empty() || line.starts_with('#') {
-        return None;
-    }
-    let mut v = [0f64; 8];
-    let mut fields = line.split(',');
-    for slot in &mut v {
-        *slot = fields.next()?.trim().parse().ok()?;
-    }
-    Some(PoseSample {
-        t: v[0],
-        pos: [v[1], v[2], v[3]],
-        quat: [v[4], v[5], v[6], v[7]],
-    })
-}
-
 fn record_path(base: &Path, n: usize) -> PathBuf {
     if n == 0 {
         return base.to_path_buf();
@@ -106,6 +88,8 @@ struct Session<'a> {
     next_retry: Instant,
     times: Vec<f64>,
     sent: usize,
+    /// Poses [`Pose::quantize`] refused (recorded, not sent).
+    unsendable: u64,
     record: Option<BufWriter<File>>,
     print: &'a Mutex<std::io::Stdout>,
     many: bool,
@@ -201,12 +185,16 @@ impl Session<'_> {
         }
         self.sent += 1;
         self.ensure_connected();
-        if let Ok(p) = Pose::quantize(i as u16, s.t, s.pos, s.quat) {
-            if let Some(dev) = self.dev.as_mut() {
-                if let Err(e) = dev.send(&HostToDevice::Pose(p)) {
-                    self.lost(&e);
+        match Pose::quantize(i as u16, s.t, s.pos, s.quat) {
+            Ok(p) => {
+                if let Some(dev) = self.dev.as_mut() {
+                    if let Err(e) = dev.send(&HostToDevice::Pose(p)) {
+                        self.lost(&e);
+                    }
                 }
             }
+            // Recorded all the same: only the wire cannot carry it.
+            Err(_) => self.unsendable += 1,
         }
         self.print_events();
         Ok(())
@@ -219,6 +207,13 @@ impl Session<'_> {
             }
         }
         self.print_events();
+        if self.unsendable > 0 {
+            eprintln!(
+                "{}: {} poses the wire cannot carry (a time or position out of its range, or \
+                 not a number) were recorded but not sent",
+                self.label, self.unsendable
+            );
+        }
     }
 }
 
@@ -265,6 +260,7 @@ fn run_session(
         next_retry: Instant::now(),
         times: vec![f64::NAN; SEQ_RING],
         sent: 0,
+        unsendable: 0,
         record,
         print,
         many,
@@ -294,13 +290,23 @@ fn run_session(
         }
         None => {
             let stdin = std::io::stdin();
-            for line in stdin.lock().lines() {
+            let mut lines = PoseLines::new(stdin.lock());
+            while let Some(p) = lines.next_sample()? {
                 if stop.load(Ordering::Relaxed) {
                     break;
                 }
-                if let Some(p) = parse_pose_line(&line?) {
-                    s.pose(&p)?;
-                }
+                s.pose(&p)?;
+            }
+            let c = lines.counts();
+            if c.dropped() > 0 {
+                eprintln!(
+                    "{}: {} input lines were not pose samples (t,x,y,z,qw,qx,qy,qz) and were \
+                     dropped: {} malformed, {} longer than {MAX_LINE_BYTES} bytes",
+                    s.label,
+                    c.dropped(),
+                    c.malformed,
+                    c.too_long
+                );
             }
         }
     }
@@ -428,17 +434,6 @@ fn start_view(args: &LiveArgs, names: &[String], characters: usize) -> Result<Vi
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn pose_lines_parse_and_bad_lines_are_skipped() {
-        let p = parse_pose_line("0.5,1,2,3,1,0,0,0,extra").unwrap();
-        assert_eq!(p.t, 0.5);
-        assert_eq!(p.pos, [1.0, 2.0, 3.0]);
-        assert!(parse_pose_line("t,x,y,z,qw,qx,qy,qz").is_none());
-        assert!(parse_pose_line("# comment").is_none());
-        assert!(parse_pose_line("1,2,3").is_none());
-        assert!(parse_pose_line("").is_none());
-    }
 
     #[test]
     fn record_paths_number_extra_figurines() {

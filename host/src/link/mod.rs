@@ -6,6 +6,7 @@
 pub mod blobs;
 pub mod cli;
 pub mod device;
+pub mod lines;
 pub mod live;
 pub mod replay;
 pub mod transport;

@@ -66,7 +66,16 @@ impl Calibration {
             reason,
         };
         let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-        let cal: Calibration = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        Self::from_json(&text, path)
+    }
+
+    /// Parses and checks the text of calibration file `path` (named in errors).
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, TrackError> {
+        let bad = |reason: String| TrackError::BadCalibration {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let cal: Calibration = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         cal.check().map_err(bad)?;
         Ok(cal)
     }

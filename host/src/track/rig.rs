@@ -236,7 +236,18 @@ impl Rig {
     pub fn read(path: &Path, family: Family, tag_size: f64) -> Result<Self, TrackError> {
         let bad = |reason: String| TrackError::BadRig(format!("{}: {reason}", path.display()));
         let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-        let file: RigFile = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        Self::from_json(&text, path, family, tag_size)
+    }
+
+    /// Parses and checks the text of rig file `path` (named in errors); as [`Rig::read`].
+    pub fn from_json(
+        text: &str,
+        path: &Path,
+        family: Family,
+        tag_size: f64,
+    ) -> Result<Self, TrackError> {
+        let bad = |reason: String| TrackError::BadRig(format!("{}: {reason}", path.display()));
+        let file: RigFile = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         let mut faces = Vec::with_capacity(file.faces.len());
         for (i, f) in file.faces.iter().enumerate() {
             let face = face_from(f).map_err(|e| bad(format!("face {}: {e}", i + 1)))?;
@@ -408,6 +419,34 @@ mod tests {
         // A one-face rig is the chest tag: its body is its tag.
         let one = Rig::single(7, 0.04);
         assert_eq!(one.faces[0].corners_in_body(0.04), object_corners(0.04));
+    }
+
+    /// The seed of the `track_files` fuzz target (a rig file, a NUL, a calibration file) is
+    /// accepted whole: the box rig with its top tag and a 60° camera.
+    #[test]
+    fn the_fuzz_seed_is_a_rig_and_a_calibration_the_readers_accept() {
+        let seed = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/seeds/track_files/box-rig-and-calibration.txt");
+        let bytes = std::fs::read(seed).unwrap();
+        let nul = bytes.iter().position(|&b| b == 0).unwrap();
+        let rig_text = std::str::from_utf8(&bytes[..nul]).unwrap();
+        let cal_text = std::str::from_utf8(&bytes[nul + 1..]).unwrap();
+        let rig = Rig::from_json(rig_text, Path::new("RIG.json"), Family::Tag36h11, 0.04).unwrap();
+        let mut boxed = Rig::boxed(0, 0.04, 0.08, 0.08);
+        boxed.faces.push(Rig::top_face(4, 0.09));
+        assert_eq!(rig.faces.len(), boxed.faces.len());
+        for (a, b) in rig.faces.iter().zip(&boxed.faces) {
+            assert!(
+                (a.centre - b.centre).length() < 1e-12,
+                "{} {}",
+                a.name,
+                b.name
+            );
+            assert!(a.rotation.dot(b.rotation).abs() > 1.0 - 1e-12, "{}", a.name);
+        }
+        let cal =
+            crate::track::pose::Calibration::from_json(cal_text, Path::new("CAL.json")).unwrap();
+        assert_eq!((cal.width, cal.height), (640, 480));
     }
 
     #[test]
