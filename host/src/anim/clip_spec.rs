@@ -113,9 +113,9 @@ impl<'de> Deserialize<'de> for ActionEntry {
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ActionEntry, A::Error> {
                 let spec =
                     ActionSpec::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
-                Ok(ActionEntry {
-                    variants: vec![spec],
-                })
+                let variants = vec![spec];
+                check_variants(&variants).map_err(A::Error::custom)?;
+                Ok(ActionEntry { variants })
             }
 
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<ActionEntry, A::Error> {
@@ -130,7 +130,8 @@ impl<'de> Deserialize<'de> for ActionEntry {
     }
 }
 
-/// Rules of a variant list: 1..=MAX_VARIANTS clips, distinct names, one `moving`.
+/// Rules of a variant list: 1..=MAX_VARIANTS clips, distinct names, one `moving`, a positive
+/// `scale` where one is given.
 pub(crate) fn check_variants(variants: &[ActionSpec]) -> Result<(), String> {
     if variants.is_empty() {
         return Err("empty variant list: an action needs at least one clip".into());
@@ -143,6 +144,13 @@ pub(crate) fn check_variants(variants: &[ActionSpec]) -> Result<(), String> {
     }
     let mut names: Vec<String> = Vec::with_capacity(variants.len());
     for v in variants {
+        // Zero, negative or not a number would collapse, mirror or blank out every pose.
+        if let Some(s) = v.scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(format!(
+                "\"scale\" {s}: metres per unit of the clip file, a positive number (0.01 for \
+                 centimetres)"
+            ));
+        }
         let n = v.variant_name();
         if names.contains(&n) {
             return Err(format!(
@@ -211,6 +219,15 @@ mod tests {
                 "a clip object or a list of clip objects",
             ),
             (format!("[{many}]"), "at most 16 clips"),
+            (
+                r#"{ "file": "a.bvh", "moving": false, "cyclic": false, "scale": 0 }"#.to_string(),
+                "\"scale\" 0: metres per unit",
+            ),
+            (
+                r#"[{ "file": "a.bvh", "moving": false, "cyclic": false, "scale": -0.01 }]"#
+                    .to_string(),
+                "a positive number",
+            ),
         ];
         for (entry, want) in cases {
             let text = format!("{{\n\"version\": 1,\n\"actions\": {{\n\"kick\": {entry}\n}}\n}}");
