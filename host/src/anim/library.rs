@@ -513,7 +513,8 @@ fn select_frames(
     if let Some([a, b]) = spec.frames {
         if a >= b || b >= clip.frames.len() {
             return Err(AnimError::Data(format!(
-                "{origin}: action {action}: frame range [{a}, {b}] is not inside the clip's {} frames",
+                "{origin}: action {action}: frame range [{a}, {b}]: a first and a later last \
+                 frame of the clip's {} (numbered from 0)",
                 clip.frames.len()
             )));
         }
@@ -578,6 +579,35 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.starts_with("lib.json:4:"), "{err}");
+    }
+
+    #[test]
+    fn a_frame_range_must_run_forward_inside_its_clip() {
+        let dir = std::env::temp_dir().join(format!("figurine-clip-range-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bvh = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition Yposition \
+                   Zposition Zrotation Xrotation Yrotation\n  End Site\n  {\n    OFFSET 0 10 0\n  \
+                   }\n}\nMOTION\nFrames: 4\nFrame Time: 0.0333333\n0 90 0 0 0 0\n0 91 5 0 0 0\n\
+                   0 92 10 0 0 0\n0 91 15 0 0 0\n";
+        std::fs::write(dir.join("hop.bvh"), bvh).unwrap();
+        let load = |frames: &str| {
+            let text = format!(
+                r#"{{ "version": 1, "actions": {{ "jump": {{ "file": "hop.bvh", "moving": true,
+                    "cyclic": false, "frames": {frames} }} }} }}"#
+            );
+            let lib = ClipLibrary::parse(&text, Path::new("hop.json"), Some(dir.clone())).unwrap();
+            lib.load(["jump"]).map(|c| c["jump"].clip.len())
+        };
+        assert_eq!(load("[1, 3]").unwrap(), 3);
+        // One frame is no motion; a range past the end or backwards is a typo.
+        for bad in ["[2, 2]", "[1, 4]", "[3, 1]"] {
+            let err = load(bad).unwrap_err().to_string();
+            assert!(
+                err.contains("a first and a later last frame of the clip's 4 (numbered from 0)"),
+                "{bad}: {err}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
