@@ -312,6 +312,48 @@ fn animate_refuses_events_with_absurd_times() {
     }
 }
 
+#[test]
+fn animate_warns_of_a_clip_read_in_the_wrong_unit() {
+    let dir = scratch("animate-unit");
+    let doodle = dir.join("doodle.csv");
+    write_ok_log(&doodle, 3.0);
+    let events = dir.join("events.jsonl");
+    std::fs::write(&events, event("jump", 0.5, 1.5) + "\n").unwrap();
+    std::fs::write(dir.join("clip.bvh"), humanoid_bvh(40)).unwrap();
+    let clips = dir.join("clips.json");
+    let out = dir.join("out.bvh");
+    let stderr_with = |extra: &str| {
+        std::fs::write(&clips, clip_library("clip.bvh", extra)).unwrap();
+        let done = malformed::figurine()
+            .arg("animate")
+            .arg("--events")
+            .arg(&events)
+            .arg("--doodle")
+            .arg(&doodle)
+            .arg("--clips")
+            .arg(&clips)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&done.stderr).into_owned();
+        assert!(done.status.success(), "{extra}: {stderr}");
+        stderr
+    };
+    // The fixture is in centimetres, as BVH's default scale has it.
+    let fine = stderr_with("");
+    assert!(!fine.contains("warning"), "{fine}");
+    // Read as metres: still animated, with a warning naming the library, clip and height.
+    let metres = stderr_with(r#","scale":1"#);
+    assert!(
+        metres.contains("warning: ")
+            && metres.contains("clips.json")
+            && metres.contains("clip.bvh")
+            && metres.contains("m tall"),
+        "{metres}"
+    );
+}
+
 /// Builds a small valid graph from generated clips; returns its path.
 fn small_graph(dir: &Path) -> PathBuf {
     let clips = dir.join("clips");

@@ -6,7 +6,7 @@ use anyhow::{bail, Context};
 
 use super::assemble::{assemble_guided, AssembleOptions, Assembly};
 use super::graph_cuts::GraphGuide;
-use super::library::ClipLibrary;
+use super::library::{size_warnings, ClipLibrary};
 use super::phrasing::detect_stages;
 use super::plot::save_contact_sheet;
 use super::trajectory::DEFAULT_WORLD_SCALE;
@@ -193,6 +193,9 @@ pub fn run_animate(args: &AnimateArgs) -> anyhow::Result<()> {
     };
     let actions: Vec<&str> = events.iter().map(|e| e.action.as_str()).collect();
     let clips = library.load(actions.iter().copied())?;
+    for w in size_warnings(&clips) {
+        eprintln!("warning: {}: {w}", library.origin);
+    }
     let opts = AssembleOptions {
         world_scale: args.world_scale,
         fps: args.fps,

@@ -533,6 +533,43 @@ fn select_frames(
     Ok(())
 }
 
+/// Heights a character may stand in its clips, metres: a child on all fours to a tall adult.
+/// Outside it, a clip's length unit is almost surely wrong (a centimetre take read as metres
+/// stands a hundred times too tall, and the animation slows to keep its root at a person's
+/// speed).
+pub const PERSON_HEIGHT_M: (f32, f32) = (0.3, 3.0);
+
+/// One warning per loaded clip (every variant) whose character stands outside
+/// [`PERSON_HEIGHT_M`]: the most its joints span vertically in any frame, after the library's
+/// `scale`.
+pub fn size_warnings(clips: &BTreeMap<String, ActionClip>) -> Vec<String> {
+    let mut out = Vec::new();
+    for (action, ac) in clips {
+        for v in ac.variants() {
+            let tallest = (0..v.clip.len())
+                .map(|f| {
+                    let ys = v.clip.joint_positions(f).into_iter().map(|p| p.y);
+                    let (lo, hi) = ys.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), y| {
+                        (lo.min(y), hi.max(y))
+                    });
+                    hi - lo
+                })
+                .fold(0.0, f32::max);
+            let (least, most) = PERSON_HEIGHT_M;
+            if !(least..=most).contains(&tallest) {
+                out.push(format!(
+                    "action {action}, clip {} ({}): the character stands {tallest:.2} m tall, \
+                     not {least}–{most} m; is the library's \"scale\" (metres per unit of the \
+                     file: 0.01 for centimetres, the default for BVH) right for it?",
+                    v.variant,
+                    v.file.display()
+                ));
+            }
+        }
+    }
+    out
+}
+
 /// Sets every variant's [`ActionClip::effort`] from its own LMA measurements, standardised over
 /// all the variants' windows ([`variant_efforts`]).
 pub(crate) fn sign_variants(variants: &mut [ActionClip]) -> Result<(), GraphError> {
@@ -611,6 +648,35 @@ mod tests {
     }
 
     #[test]
+    fn a_clip_read_at_the_wrong_scale_is_named() {
+        let dir = std::env::temp_dir().join(format!("figurine-clip-size-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Hips 90 cm up, a head end 70 cm above them, a foot on the floor: 1.6 m in centimetres.
+        let bvh = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition Yposition \
+                   Zposition Zrotation Xrotation Yrotation\n  JOINT Head\n  {\n    OFFSET 0 60 0\n    \
+                   CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 10 \
+                   0\n    }\n  }\n  JOINT Leg\n  {\n    OFFSET 0 -45 0\n    CHANNELS 3 Zrotation \
+                   Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -45 0\n    }\n  }\n}\n\
+                   MOTION\nFrames: 2\nFrame Time: 0.0333333\n0 90 0 0 0 0 0 0 0 0 0 0\n\
+                   0 90 5 0 0 0 0 0 0 0 0 0\n";
+        std::fs::write(dir.join("stand.bvh"), bvh).unwrap();
+        let warnings = |scale: &str| {
+            let text = format!(
+                r#"{{ "version": 1, "actions": {{ "walk": {{ "file": "stand.bvh", "moving": true,
+                    "cyclic": true {scale} }} }} }}"#
+            );
+            let lib = ClipLibrary::parse(&text, Path::new("w.json"), Some(dir.clone())).unwrap();
+            size_warnings(&lib.load(["walk"]).unwrap())
+        };
+        assert!(warnings("").is_empty(), "centimetres by default");
+        let metres = warnings(r#", "scale": 1"#);
+        assert_eq!(metres.len(), 1, "{metres:?}");
+        assert!(metres[0].contains("stands 160.00 m tall"), "{}", metres[0]);
+        assert!(warnings(r#", "scale": 0.0001"#)[0].contains("stands 0.02 m tall"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
     fn default_kick_variants_follow_the_effort() {
         if crate::data::data_file("deepmimic", "humanoid.urdf").is_none() {
             eprintln!("skipping: deepmimic data missing — run `cargo xtask setup`");
@@ -652,6 +718,7 @@ mod tests {
         let names: Vec<String> = lib.actions.keys().cloned().collect();
         let clips = lib.load(names.iter().map(String::as_str)).unwrap();
         assert_eq!(clips.len(), 12);
+        assert_eq!(size_warnings(&clips), Vec::<String>::new());
         let crouch = &clips["crouch"].clip;
         // Ping-pong: starts and ends on the same (standing) pose.
         let (a, b) = (&crouch.frames[0], &crouch.frames[crouch.len() - 1]);
