@@ -135,8 +135,9 @@ const TARGETS: &[Target] = &[
         real_seeds: &[],
         max_len: 0,
     },
-    // Seed (host/fuzz/seeds/): a library of one clip, one cut both ways and two variants, over the
-    // target's own two BVH takes; the shipped library names files in folders, which it skips.
+    // Seed (host/fuzz/seeds/): three actions over the target's own two BVH takes — a whole
+    // clip, a cut one played to both sides, two variants (ping-ponged, scaled). The shipped
+    // library names files in folders, which the target skips.
     Target {
         dir: "host/fuzz",
         name: "clip_library",
