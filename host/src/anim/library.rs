@@ -618,22 +618,40 @@ mod tests {
         assert!(err.starts_with("lib.json:4:"), "{err}");
     }
 
+    /// A person 1.6 m tall in centimetres, as BVH files usually are: hips 90 cm up, a head end
+    /// 70 cm above them, a foot on the floor; 4 frames at 30 Hz, stepping forward.
+    const STAND_BVH: &str = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition \
+        Yposition Zposition Zrotation Xrotation Yrotation\n  JOINT Head\n  {\n    OFFSET 0 60 0\n    \
+        CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 10 0\n    }\n  \
+        }\n  JOINT Leg\n  {\n    OFFSET 0 -45 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    \
+        End Site\n    {\n      OFFSET 0 -45 0\n    }\n  }\n}\nMOTION\nFrames: 4\nFrame Time: \
+        0.0333333\n0 90 0 0 0 0 0 0 0 0 0 0\n0 90 5 0 0 0 0 0 0 0 0 0\n0 90 10 0 0 0 0 0 0 0 0 0\n\
+        0 90 15 0 0 0 0 0 0 0 0 0\n";
+
+    /// Loads `action` from a library of that one action, `{"file": "stand.bvh", …}` plus
+    /// `fields`, next to [`STAND_BVH`] in a folder of its own (`tag`).
+    fn load_stand(
+        tag: &str,
+        action: &str,
+        fields: &str,
+    ) -> Result<BTreeMap<String, ActionClip>, AnimError> {
+        let dir = std::env::temp_dir().join(format!("figurine-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("stand.bvh"), STAND_BVH).unwrap();
+        let text = format!(
+            r#"{{ "version": 1, "actions": {{ "{action}": {{ "file": "stand.bvh" {fields} }} }} }}"#
+        );
+        let lib = ClipLibrary::parse(&text, Path::new("stand.json"), Some(dir.clone())).unwrap();
+        let loaded = lib.load([action]);
+        std::fs::remove_dir_all(&dir).ok();
+        loaded
+    }
+
     #[test]
     fn a_frame_range_must_run_forward_inside_its_clip() {
-        let dir = std::env::temp_dir().join(format!("figurine-clip-range-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let bvh = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition Yposition \
-                   Zposition Zrotation Xrotation Yrotation\n  End Site\n  {\n    OFFSET 0 10 0\n  \
-                   }\n}\nMOTION\nFrames: 4\nFrame Time: 0.0333333\n0 90 0 0 0 0\n0 91 5 0 0 0\n\
-                   0 92 10 0 0 0\n0 91 15 0 0 0\n";
-        std::fs::write(dir.join("hop.bvh"), bvh).unwrap();
         let load = |frames: &str| {
-            let text = format!(
-                r#"{{ "version": 1, "actions": {{ "jump": {{ "file": "hop.bvh", "moving": true,
-                    "cyclic": false, "frames": {frames} }} }} }}"#
-            );
-            let lib = ClipLibrary::parse(&text, Path::new("hop.json"), Some(dir.clone())).unwrap();
-            lib.load(["jump"]).map(|c| c["jump"].clip.len())
+            let fields = format!(r#", "moving": true, "cyclic": false, "frames": {frames}"#);
+            load_stand("clip-range", "jump", &fields).map(|c| c["jump"].clip.len())
         };
         assert_eq!(load("[1, 3]").unwrap(), 3);
         // One frame is no motion; a range past the end or backwards is a typo.
@@ -644,36 +662,19 @@ mod tests {
                 "{bad}: {err}"
             );
         }
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
     fn a_clip_read_at_the_wrong_scale_is_named() {
-        let dir = std::env::temp_dir().join(format!("figurine-clip-size-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        // Hips 90 cm up, a head end 70 cm above them, a foot on the floor: 1.6 m in centimetres.
-        let bvh = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition Yposition \
-                   Zposition Zrotation Xrotation Yrotation\n  JOINT Head\n  {\n    OFFSET 0 60 0\n    \
-                   CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 10 \
-                   0\n    }\n  }\n  JOINT Leg\n  {\n    OFFSET 0 -45 0\n    CHANNELS 3 Zrotation \
-                   Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -45 0\n    }\n  }\n}\n\
-                   MOTION\nFrames: 2\nFrame Time: 0.0333333\n0 90 0 0 0 0 0 0 0 0 0 0\n\
-                   0 90 5 0 0 0 0 0 0 0 0 0\n";
-        std::fs::write(dir.join("stand.bvh"), bvh).unwrap();
         let warnings = |scale: &str| {
-            let text = format!(
-                r#"{{ "version": 1, "actions": {{ "walk": {{ "file": "stand.bvh", "moving": true,
-                    "cyclic": true {scale} }} }} }}"#
-            );
-            let lib = ClipLibrary::parse(&text, Path::new("w.json"), Some(dir.clone())).unwrap();
-            size_warnings(&lib.load(["walk"]).unwrap())
+            let fields = format!(r#", "moving": true, "cyclic": true {scale}"#);
+            size_warnings(&load_stand("clip-size", "walk", &fields).unwrap())
         };
         assert!(warnings("").is_empty(), "centimetres by default");
         let metres = warnings(r#", "scale": 1"#);
         assert_eq!(metres.len(), 1, "{metres:?}");
         assert!(metres[0].contains("stands 160.00 m tall"), "{}", metres[0]);
         assert!(warnings(r#", "scale": 0.0001"#)[0].contains("stands 0.02 m tall"));
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
