@@ -33,6 +33,46 @@ fn csvs(dir: &Path) -> Vec<String> {
 }
 
 #[test]
+fn learning_from_many_examples_names_the_odd_ones_it_left_out() {
+    // Twelve sidesteps: the pattern keeps what three of them show alike, and an example it
+    // then does not read is named as an odd one, not as a reason to add more.
+    let d = tmp("many");
+    let lib = d.join("lib.json");
+    let ex = d.join("sidestep");
+    let out = figurine(&[
+        "synth",
+        "examples",
+        "--action",
+        "sidestep",
+        "--count",
+        "12",
+        "--seed",
+        "3",
+        "--out",
+        ex.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let files = csvs(&ex);
+    let mut args = vec![
+        "learn",
+        "--library",
+        lib.to_str().unwrap(),
+        "--name",
+        "sidestep",
+    ];
+    args.extend(files.iter().map(String::as_str));
+    let out = figurine(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let read = err.matches("read back as `sidestep`\n").count();
+    let odd = err
+        .matches("of 12 examples the pattern keeps what 3 show alike")
+        .count();
+    assert!(odd >= 1 && read + odd == 12, "{err}");
+    assert!(!err.contains("add examples"), "{err}");
+}
+
+#[test]
 fn learn_then_simulate_a_sequence() {
     let d = tmp("learn");
     let lib = d.join("lib.json");

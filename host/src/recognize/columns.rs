@@ -3,11 +3,12 @@
 //! | step | what |
 //! |---|---|
 //! | mandatory runs | in every string, a run is *mandatory* when it lasts at least [`MANDATORY_SHARE`] of that gesture's moving time (a deliberate part of the gesture), otherwise *optional* (a transition or a wobble); the seed's "repeated more than twice" counts samples, durations make the rule independent of the sample rate |
-//! | columns | the mandatory strings are aligned to the reference's by edit distance; column i becomes `(m_i0\|…\|m_in)+`, or `…*` when some example lacks it; a stroke that turned as it moved is written with its plain stroke too (`db.Xn\|db`, [`with_plain`]: the turn may fall under the token threshold in another performance) |
-//! | optional runs | the optional tokens between two columns become `(o_1\|…\|o_k)*` before the later column — or mandatory columns when every example has the same optional sequence there |
-//! | repetition | a cyclic action's whole pattern repeats; a pattern needs two tokens at least: when its only mandatory column is a part every example performs twice or more (a run's strides), that column is written twice |
+//! | quorum | a variation is kept when [`quorum`] strings show it: any one of three to six examples and their average, a quarter of more (one odd performance among many no longer widens the pattern) |
+//! | columns | the mandatory strings are aligned to the reference's (the one with the fewest mandatory runs, the quorum-th fewest) by edit distance; column i becomes `(m_i0\|…\|m_in)+` of the tokens a quorum showed there, or `…*` when most strings lack it or a quorum of performances too short for an edit do; a stroke that turned as it moved is written with its plain stroke too (`db.Xn\|db`, [`with_plain`]: the turn may fall under the token threshold in another performance) |
+//! | optional runs | the optional tokens a quorum showed between two columns become `(o_1\|…\|o_k)*` before the later column — or mandatory columns when every example has the same optional sequence there |
+//! | repetition | a cyclic action's whole pattern repeats (cyclic: the reference repeats a cycle, or a quorum of performances is closer to it done twice, or two near-copies of one part); a pattern needs two tokens at least: when its only mandatory column is a part every example performs twice or more (a run's strides), that column is written twice |
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use anyhow::{bail, Result};
 use figurine_recognizer::alignment::FULL;
@@ -55,6 +56,27 @@ pub(super) fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
         }
     }
     mand
+}
+
+/// How many of the strings a pattern is learnt from (the examples and their average) must show
+/// a variation for the pattern to keep it — a token in a column or between columns, a column
+/// an example too short for an edit lacked, a repetition that makes the action cyclic — and
+/// which order statistic the learnt bounds take ([`super::learn`]): of m strings the k-th
+/// extreme with k = m / 4 rounded down, at least one — the most extreme whose expected
+/// quantile, k / m, is at most the quarter that the least of three examples estimates. Three
+/// to six examples give one, the extreme itself; seven to ten give two; eleven to fourteen
+/// three. So one odd performance among many no longer widens the pattern for all of them: a
+/// union of every variation seen grows with each example, and read carried toys as actions.
+pub fn quorum(strings: usize) -> usize {
+    (strings / 4).max(1)
+}
+
+/// The `q`-th smallest of `values` (1-based, by `f32::total_cmp`), or the largest when there
+/// are fewer; None when empty: the order statistic [`quorum`] asks for.
+pub fn order_statistic(mut values: Vec<f32>, q: usize) -> Option<f32> {
+    values.sort_by(f32::total_cmp);
+    let k = q.max(1).min(values.len());
+    values.get(k.checked_sub(1)?).copied()
 }
 
 /// Mandatory columns a learnt pattern keeps at least (when its reference has that many).
@@ -214,25 +236,29 @@ fn align(a: &[Token], b: &[Token]) -> Vec<Op> {
 
 /// Learns a regex from tokenized sequences; `seqs[0]` is the reference (the average doodle).
 pub fn learn_regex(seqs: &[Tokenized]) -> Result<Regex> {
-    learn_regex_within(seqs, MAX_POSITIONS)
+    learn_regex_within(seqs, MAX_POSITIONS, quorum(seqs.len()))
 }
 
-/// [`learn_regex`] with at most `budget` token positions (optional groups are dropped first).
-pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
+/// [`learn_regex`] with at most `budget` token positions (optional groups are dropped first),
+/// keeping a variation that `quorum` strings show ([`quorum`]).
+pub fn learn_regex_within(seqs: &[Tokenized], budget: usize, quorum: usize) -> Result<Regex> {
+    let q = quorum.max(1);
     let mut seqs: Vec<&Tokenized> = seqs.iter().filter(|s| !s.is_empty()).collect();
     // Reference: the sequence with the fewest mandatory runs (the first — the average — on
-    // ties). Performances differ most in how many times they repeat a cycle; longer ones are
-    // covered by repeating the whole pattern.
+    // ties), the quorum-th fewest among many. Performances differ most in how many times they
+    // repeat a cycle; longer ones are covered by repeating the whole pattern.
     // (At least two mandatory runs: a one-token pattern would fire on any motion.)
     let counts: Vec<usize> = seqs.iter().map(|s| mandatory_runs(s).len()).collect();
-    let Some(best) = (0..seqs.len())
-        .filter(|&i| counts[i] >= 2)
-        .min_by_key(|&i| (counts[i], i))
+    let mut by_count: Vec<usize> = (0..seqs.len()).filter(|&i| counts[i] >= 2).collect();
+    by_count.sort_by_key(|&i| (counts[i], i));
+    let Some(best) = by_count
+        .get(q.min(by_count.len()).saturating_sub(1))
+        .copied()
         .or_else(|| (0..seqs.len()).max_by_key(|&i| (counts[i], usize::MAX - i)))
     else {
         bail!("no motion found in any example (all still?)");
     };
-    // Cyclic when some performance is closer to the reference done twice than once.
+    // Cyclic when a quorum of performances is closer to the reference done twice than once.
     let mand_of = |s: &Tokenized| -> Vec<Token> { mandatory_runs(s).iter().map(|m| m.0).collect() };
     let once = mand_of(seqs[best]);
     let twice: Vec<Token> = once.iter().chain(once.iter()).copied().collect();
@@ -247,18 +273,22 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     };
     let periodic =
         (2..=once.len() / 2).any(|p| (0..once.len() - p).all(|i| key(once[i]) == key(once[i + p])));
-    // … or when some performance is two near-copies of one part (by translation, as above):
-    // its halves differ by at most one run.
+    // … or when a quorum of performances is two near-copies of one part (by translation):
+    // each one's halves differ by at most one run.
     let halves = |s: &Tokenized| {
         let m: Vec<Token> = mand_of(s).into_iter().map(key).collect();
         m.len() >= 4 && (2..=m.len() - 2).any(|p| edit_distance(&m[..p], &m[p..]) <= 1)
     };
     let cyclic = periodic
-        || seqs.iter().any(|s| {
-            let m = mand_of(s);
-            edit_distance(&m, &twice) < edit_distance(&m, &once)
-        })
-        || seqs.iter().any(|s| halves(s));
+        || seqs
+            .iter()
+            .filter(|s| {
+                let m = mand_of(s);
+                edit_distance(&m, &twice) < edit_distance(&m, &once)
+            })
+            .count()
+            >= q
+        || seqs.iter().filter(|s| halves(s)).count() >= q;
     // A cyclic action rocks one way and back from cycle to cycle: which way a stroke wobbled
     // is no part of it. (A one-shot gesture's small turn keeps its sign: a throw's follow-through
     // dips forward, whatever else varies.)
@@ -274,10 +304,12 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     let reference = seqs[0];
     let ref_m: Vec<Token> = mandatory_runs(reference).iter().map(|m| m.0).collect();
     let n = ref_m.len();
-    let mut cols: Vec<BTreeSet<Token>> = ref_m.iter().map(|&t| BTreeSet::from([t])).collect();
+    // seen[i][token]: the strings that showed `token` in column i (the reference's own token
+    // is kept whatever the count).
+    let mut seen: Vec<BTreeMap<Token, BTreeSet<usize>>> = vec![BTreeMap::new(); n];
     let mut missing = vec![0usize; n];
-    // Columns a performance too short to afford one edit on the device lacks.
-    let mut lacked_by_short = vec![false; n];
+    // Performances too short to afford one edit on the device that lack each column.
+    let mut lacked_by_short = vec![0usize; n];
     // gaps[g][k]: optional tokens of sequence k before column g (g = n: after the last).
     let mut gaps: Vec<Vec<Vec<Token>>> = vec![vec![Vec::new(); seqs.len()]; n + 1];
     for (k, s) in seqs.iter().enumerate() {
@@ -290,12 +322,12 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         for op in &ops {
             match *op {
                 Op::Pair(i, j) => {
-                    cols[i].insert(mt[j]);
+                    seen[i].entry(mt[j]).or_default().insert(k);
                     col_of[j] = Some(i);
                 }
                 Op::Del(i) => {
                     missing[i] += 1;
-                    lacked_by_short[i] |= !edits_fit(FULL, s.len());
+                    lacked_by_short[i] += usize::from(!edits_fit(FULL, s.len()));
                 }
                 Op::Ins(_) => {}
             }
@@ -314,7 +346,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             {
                 is_col[i] = is_col[i - 1];
                 if let Some(c) = is_col[i] {
-                    cols[c].insert(s[i].0);
+                    seen[c].entry(s[i].0).or_default().insert(k);
                 }
             }
         }
@@ -328,6 +360,17 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
             }
         }
     }
+    let cols: Vec<BTreeSet<Token>> = seen
+        .iter()
+        .zip(&ref_m)
+        .map(|(by, &own)| {
+            by.iter()
+                .filter(|(_, who)| who.len() >= q)
+                .map(|(&t, _)| t)
+                .chain([own])
+                .collect()
+        })
+        .collect();
     // Build the expression, then shrink optional groups if over capacity.
     let mut opt: Vec<Option<Regex>> = Vec::with_capacity(n + 1);
     let mut opt_support: Vec<usize> = Vec::new();
@@ -342,7 +385,17 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
         }
         // Optional groups keep whole wildcards: they tell little apart, and the pattern's
         // positions are better spent on its mandatory columns.
-        let set: BTreeSet<Token> = per_seq.iter().flatten().map(|&t| bare(t)).collect();
+        let mut shown: BTreeMap<Token, usize> = BTreeMap::new();
+        for v in per_seq {
+            let own: BTreeSet<Token> = v.iter().map(|&t| bare(t)).collect();
+            own.into_iter()
+                .for_each(|t| *shown.entry(t).or_default() += 1);
+        }
+        let set: BTreeSet<Token> = shown
+            .into_iter()
+            .filter(|&(_, c)| c >= q)
+            .map(|(t, _)| t)
+            .collect();
         if set.is_empty() {
             opt.push(None);
             opt_support.push(0);
@@ -359,7 +412,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize) -> Result<Regex> {
     let mut optional_col: Vec<bool> = missing
         .iter()
         .zip(&lacked_by_short)
-        .map(|(&m, &short)| 2 * m >= seqs.len() || short)
+        .map(|(&m, &short)| 2 * m >= seqs.len() || short >= q)
         .collect();
     let mut by_support: Vec<usize> = (0..n).collect();
     by_support.sort_by_key(|&g| (missing[g], g));
@@ -526,6 +579,41 @@ mod tests {
         }
         assert!(!c.accepts(&tokens_only(&seq("df:1 uf:1"))));
         assert!(re.to_source().contains("uf"), "{}", re.to_source());
+    }
+
+    #[test]
+    fn the_quorum_is_the_extreme_up_to_six_examples_then_a_lower_quartile() {
+        // Strings are the examples and their average.
+        let q: Vec<usize> = (1..=13).map(|examples| quorum(examples + 1)).collect();
+        assert_eq!(q, [1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3]);
+        assert_eq!(order_statistic(vec![3.0, 1.0, 2.0], 1), Some(1.0));
+        assert_eq!(order_statistic(vec![3.0, 1.0, 2.0, 0.5], 2), Some(1.0));
+        // Fewer values than asked: the largest; none: nothing.
+        assert_eq!(order_statistic(vec![3.0, 1.0], 5), Some(3.0));
+        assert_eq!(order_statistic(vec![], 1), None);
+    }
+
+    #[test]
+    fn a_variation_one_of_many_examples_shows_does_not_widen_the_pattern() {
+        // Twelve strings (performances and their average) strike forward and back; one more
+        // pitched its strike and dipped between the two strokes.
+        let plain = seq("f:0.2 b:0.2");
+        let odd = seq("f.Xn:0.2 d:0.1 b:0.2");
+        let mut many = vec![plain.clone(); 12];
+        many.push(odd.clone());
+        let re = learn_regex(&many).unwrap();
+        assert_eq!(re.to_source(), "f+ b+");
+        // The odd one is now an edit and a half away: its pitch and its dip.
+        assert!(!accepts(&re, "f.Xn d b"), "{}", re.to_source());
+        // Among three examples and their average every variation is kept, as before.
+        let few = vec![plain.clone(), plain.clone(), plain, odd.clone()];
+        let re = learn_regex(&few).unwrap();
+        assert!(accepts(&re, "f.Xn d b"), "{}", re.to_source());
+        // Three of thirteen strings showing it are a quorum: it is kept.
+        let mut some = vec![seq("f:0.2 b:0.2"); 10];
+        some.extend([odd.clone(), odd.clone(), odd]);
+        let re = learn_regex(&some).unwrap();
+        assert!(accepts(&re, "f.Xn d b"), "{}", re.to_source());
     }
 
     #[test]

@@ -14,6 +14,13 @@
 //! shape and how much that varied ([`mean_shape`], [`shape_tolerance`]), how far the least of
 //! them went ([`least_extent`]), the longest stillness inside one ([`longest_hold`]) and the
 //! fewest sub-movements one made ([`fewest_sweeps`]).
+//!
+//! Every variation the pattern keeps and every bound is an order statistic of the examples
+//! ([`super::columns::quorum`]): from three to six examples the extreme (what any one showed,
+//! the least of them), from seven on the lower quartile's, so that a user who teaches more
+//! examples gets a pattern no looser than three would give — taken as a union of all, every
+//! odd performance widened it, and twelve examples read carried toys as actions three times
+//! as often as three did.
 
 use std::path::PathBuf;
 
@@ -25,7 +32,7 @@ use figurine_recognizer::history::{Run, Sweeps};
 use figurine_recognizer::shape::SHAPE_SCALE;
 use figurine_recognizer::token::STILL;
 
-use super::columns::learn_regex;
+use super::columns::{learn_regex, order_statistic, quorum};
 use super::dtw;
 use super::feed::{
     gesture_runs, log_gesture, log_runs, log_runs_and_noise, log_samples, nothing_moved_words,
@@ -121,20 +128,35 @@ fn extent_of_runs(g: &[Run]) -> Extent {
     sums.extent()
 }
 
-/// The longest stillness inside any of the gestures (each from its first to its last motion),
-/// seconds; None when none held still inside.
-pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<f32> {
-    gestures
-        .into_iter()
-        .flat_map(|g| g.iter().filter(|r| r.token == STILL))
-        .map(|r| run_seconds(r) as f32)
-        .reduce(f32::max)
+/// How many of `n` examples a learnt bound leaves beyond it: the [`quorum`] of the examples
+/// and their average (one of three examples: the bound is their extreme).
+pub fn examples_quorum(n: usize) -> usize {
+    quorum(n + 1)
 }
 
-/// The fewest sub-movements ([`Sweeps::count`]) any of the gestures that moved made; None
-/// without one.
+/// The longest stillness inside the gestures (each from its first to its last motion),
+/// seconds, as the [`examples_quorum`]-th longest of each gesture's longest (of three: the
+/// longest of all); None when none held still inside.
+pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<f32> {
+    let each: Vec<f32> = gestures
+        .into_iter()
+        .filter(|g| !g.is_empty())
+        .map(|g| {
+            g.iter()
+                .filter(|r| r.token == STILL)
+                .map(|r| run_seconds(r) as f32)
+                .fold(0.0, f32::max)
+        })
+        .collect();
+    let q = examples_quorum(each.len());
+    let negated = each.iter().map(|h| -h).collect();
+    order_statistic(negated, q).map(|h| -h).filter(|&h| h > 0.0)
+}
+
+/// The fewest sub-movements ([`Sweeps::count`]) the gestures that moved made, as the
+/// [`examples_quorum`]-th fewest (of three: the fewest any made); None without one.
 pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<u8> {
-    gestures
+    let mut made: Vec<u8> = gestures
         .into_iter()
         .filter(|g| !g.is_empty())
         .map(|g| {
@@ -142,15 +164,18 @@ pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Optio
             g.iter().for_each(|r| made.merge(r.sweeps));
             made.count()
         })
-        .min()
+        .collect();
+    made.sort_unstable();
+    let q = examples_quorum(made.len()).min(made.len());
+    made.get(q.checked_sub(1)?).copied()
 }
 
 /// The least extent among gestures that moved, dimension by dimension (and the least share of
-/// its own reach that one travelled): how far the least of an action's examples went, what
-/// the device holds a performance to ([`figurine_recognizer::extent::far_enough`]). None
-/// without a gesture.
+/// its own reach that one travelled), each as the [`examples_quorum`]-th least (of three: the
+/// least): how far the least of an action's examples went, what the device holds a
+/// performance to ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
 pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
-    gestures
+    let each: Vec<Extent> = gestures
         .into_iter()
         .filter(|g| !g.is_empty())
         .map(|g| {
@@ -164,12 +189,15 @@ pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
                 ..e
             }
         })
-        .reduce(|a, b| Extent {
-            moved_m: a.moved_m.min(b.moved_m),
-            turned_rad: a.turned_rad.min(b.turned_rad),
-            travel_m: a.travel_m.min(b.travel_m),
-            travel_share: a.travel_share.min(b.travel_share),
-        })
+        .collect();
+    let q = examples_quorum(each.len());
+    let least = |f: fn(&Extent) -> f32| order_statistic(each.iter().map(f).collect(), q);
+    Some(Extent {
+        moved_m: least(|e| e.moved_m)?,
+        turned_rad: least(|e| e.turned_rad)?,
+        travel_m: least(|e| e.travel_m)?,
+        travel_share: least(|e| e.travel_share)?,
+    })
 }
 
 /// The motion shapes of the examples that moved ([`motion_shape`]), read once for
@@ -183,17 +211,16 @@ pub fn example_shapes(logs: &[PoseLog]) -> Vec<Shape> {
 /// room for the next performance.
 pub const SHAPE_TOLERANCE_FLOOR: f32 = 0.06;
 
-/// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the largest
-/// |shape − mean|, weighted by `SHAPE_SCALE` as the device weighs it
-/// (`figurine_recognizer::shape::shape_penalty`), at least [`SHAPE_TOLERANCE_FLOOR`].
-/// None without shapes.
+/// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the
+/// [`examples_quorum`]-th largest |shape − mean| (of three: the largest), weighted by
+/// `SHAPE_SCALE` as the device weighs it (`figurine_recognizer::shape::shape_penalty`), at
+/// least [`SHAPE_TOLERANCE_FLOOR`]. None without shapes.
 pub fn shape_tolerance(shapes: &[Shape]) -> Option<Shape> {
     let mean = mean_shape(shapes)?;
+    let q = examples_quorum(shapes.len());
     Some(core::array::from_fn(|k| {
-        let far = shapes
-            .iter()
-            .map(|s| (s[k] - mean[k]).abs())
-            .fold(0.0f32, f32::max);
+        let negated = shapes.iter().map(|s| -(s[k] - mean[k]).abs()).collect();
+        let far = order_statistic(negated, q).map_or(0.0, |f| -f);
         (SHAPE_SCALE[k] * far).max(SHAPE_TOLERANCE_FLOOR)
     }))
 }
@@ -382,7 +409,8 @@ pub fn run(args: &LearnArgs) -> Result<()> {
 /// What the device makes of each example log with library `lib` (as written), a line each:
 /// the check a user can act on. A pattern may not accept a whole example, yet the device
 /// reads it right; and an example it reads as something else, or as two actions, or as
-/// nothing, is one to play again (or to add examples beside).
+/// nothing, is one to play again (or, among a few, to add examples beside; among many, an odd
+/// one the pattern left out, [`examples_quorum`]).
 pub fn read_back(
     lib: &mut LibraryFile,
     name: &str,
@@ -391,6 +419,18 @@ pub fn read_back(
 ) -> Result<Vec<String>> {
     let blob = lib.blob()?;
     let names = lib.names();
+    let q = examples_quorum(logs.len());
+    // Among many examples an odd one is left out on purpose: more of the same will not bring
+    // it back.
+    let advice = if q > 1 {
+        format!(
+            "of {} examples the pattern keeps what {q} show alike: play it again if it was \
+             meant as the others",
+            logs.len()
+        )
+    } else {
+        "play it again, or add examples".to_string()
+    };
     let mut lines = Vec::new();
     for (p, log) in paths.iter().zip(logs) {
         let sim = super::simulate::simulate_log(log, &names, &blob, None)?;
@@ -406,7 +446,7 @@ pub fn read_back(
         };
         let verdict = match sim.records.as_slice() {
             [r] if r.action == name => String::new(),
-            _ => format!(" — not as one `{name}`: play it again, or add examples"),
+            _ => format!(" — not as one `{name}`: {advice}"),
         };
         lines.push(format!("  {}: read back as {read}{verdict}", p.display()));
     }
@@ -513,6 +553,37 @@ mod tests {
             assert_eq!(made(&carried.log), 1, "a carry, seed {seed}");
         }
         assert_eq!(fewest_sweeps(std::iter::empty::<&[Run]>()), None);
+    }
+
+    #[test]
+    fn many_examples_bound_a_performance_by_their_lower_quartile_not_their_odd_one() {
+        let logs: Vec<PoseLog> = synth::examples(5, &Knobs::default(), Action::Jump, 12, None)
+            .into_iter()
+            .map(|d| d.log)
+            .collect();
+        let gestures: Vec<Vec<Run>> = logs.iter().map(log_gesture).collect();
+        let moved = |g: &[Vec<Run>]| least_extent(g.iter().map(|g| &g[..])).unwrap().moved_m;
+        let mut each: Vec<f32> = gestures
+            .iter()
+            .map(|g| moved(std::slice::from_ref(g)))
+            .collect();
+        each.sort_by(f32::total_cmp);
+        // Twelve examples: the third least of them; three: their least.
+        assert_eq!(moved(&gestures), each[2]);
+        let three = &gestures[..3];
+        let least_of_three = three
+            .iter()
+            .map(|g| moved(std::slice::from_ref(g)))
+            .fold(f32::INFINITY, f32::min);
+        assert_eq!(moved(three), least_of_three);
+        // A shape one example of twelve strays in: the tolerance is how far the others lie
+        // from the mean it shifted, not how far it strayed; among three it sets it.
+        let mut shapes = vec![[0.1, 0.5, 0.8, 1.0, 0.2, 0.0]; 11];
+        shapes.push([0.1, 0.5, 0.8, 1.0, 0.2, 0.9]);
+        let shifted = SHAPE_SCALE[5] * 0.9 / 12.0;
+        assert!((shape_tolerance(&shapes).unwrap()[5] - shifted).abs() < 1e-5);
+        let strayed = SHAPE_SCALE[5] * (0.9 - 0.3);
+        assert!((shape_tolerance(&shapes[9..]).unwrap()[5] - strayed).abs() < 1e-5);
     }
 
     #[test]

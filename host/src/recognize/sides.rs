@@ -11,7 +11,7 @@ use anyhow::Result;
 use figurine_recognizer::pattern::MAX_POSITIONS;
 use figurine_recognizer::token::{Token, ANY_LIN, ANY_ROT, NONE_BIN};
 
-use super::columns::{edit_distance, learn_regex, learn_regex_within, mandatory_runs};
+use super::columns::{edit_distance, learn_regex, learn_regex_within, mandatory_runs, quorum};
 use super::intent::{mirror_seq, Tokenized};
 use super::regex::Regex;
 
@@ -46,15 +46,17 @@ pub fn learn_regex_mirrored(seqs: &[Tokenized]) -> Result<Regex> {
         .all(|(a, b)| strokes(a) == strokes(b))
     {
         let joint: Vec<Tokenized> = seqs.iter().chain(&mirrored).cloned().collect();
-        if let Ok(re) = learn_regex_within(&joint, usize::MAX) {
+        // A variation and its mirror image are one performance's: the quorum stays the
+        // examples' own.
+        if let Ok(re) = learn_regex_within(&joint, usize::MAX, quorum(seqs.len())) {
             if re.positions() <= MAX_POSITIONS && re.compile()?.min_len() != usize::MAX {
                 return Ok(re);
             }
         }
     }
     if let (Ok(d), Ok(m)) = (
-        learn_regex_within(seqs, half),
-        learn_regex_within(&mirrored, half),
+        learn_regex_within(seqs, half, quorum(seqs.len())),
+        learn_regex_within(&mirrored, half, quorum(seqs.len())),
     ) {
         return Ok(Regex::Alt(vec![d, m]));
     }
@@ -182,8 +184,8 @@ mod tests {
         ];
         let mirrored: Vec<Tokenized> = seqs.iter().map(mirror_seq).collect();
         let sides = Regex::Alt(vec![
-            learn_regex_within(&seqs, usize::MAX).unwrap(),
-            learn_regex_within(&mirrored, usize::MAX).unwrap(),
+            learn_regex_within(&seqs, usize::MAX, 1).unwrap(),
+            learn_regex_within(&mirrored, usize::MAX, 1).unwrap(),
         ]);
         assert!(sides.positions() > MAX_POSITIONS, "{}", sides.to_source());
         let re = learn_regex_mirrored(&seqs).unwrap();
