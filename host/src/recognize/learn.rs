@@ -58,7 +58,8 @@ pub struct LearnArgs {
     /// Do not also accept the mirror image (left ↔ right) of the examples.
     #[arg(long)]
     pub no_mirror: bool,
-    /// Example logs, one performance each (three are usually enough).
+    /// Example logs, one performance each (three are usually enough; from seven on, the pattern
+    /// keeps what a quarter of them show alike, so an odd one is left out).
     #[arg(required = true)]
     pub examples: Vec<PathBuf>,
 }
