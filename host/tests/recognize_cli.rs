@@ -32,36 +32,44 @@ fn csvs(dir: &Path) -> Vec<String> {
     v
 }
 
+/// `figurine synth examples`: `count` performances of `action` at `seed` into `dir`, whose
+/// CSV files it returns.
+fn synth_examples(action: &str, count: usize, seed: u64, dir: &Path) -> Vec<String> {
+    let (count, seed) = (count.to_string(), seed.to_string());
+    let out = figurine(&[
+        "synth",
+        "examples",
+        "--action",
+        action,
+        "--count",
+        &count,
+        "--seed",
+        &seed,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    csvs(dir)
+}
+
+/// `figurine learn` of action `name` into `lib` from `files`.
+fn learn(lib: &Path, name: &str, files: &[String]) -> Output {
+    let mut args = vec!["learn", "--library", lib.to_str().unwrap(), "--name", name];
+    args.extend(files.iter().map(String::as_str));
+    figurine(&args)
+}
+
 #[test]
 fn learning_from_many_examples_names_the_odd_ones_it_left_out() {
     // Twelve sidesteps: the pattern keeps what three of them show alike, and an example it
     // then does not read is named as an odd one, not as a reason to add more.
     let d = tmp("many");
-    let lib = d.join("lib.json");
-    let ex = d.join("sidestep");
-    let out = figurine(&[
-        "synth",
-        "examples",
-        "--action",
-        "sidestep",
-        "--count",
-        "12",
-        "--seed",
-        "3",
-        "--out",
-        ex.to_str().unwrap(),
-    ]);
-    assert!(out.status.success());
-    let files = csvs(&ex);
-    let mut args = vec![
-        "learn",
-        "--library",
-        lib.to_str().unwrap(),
-        "--name",
-        "sidestep",
-    ];
-    args.extend(files.iter().map(String::as_str));
-    let out = figurine(&args);
+    let files = synth_examples("sidestep", 12, 3, &d.join("sidestep"));
+    let out = learn(&d.join("lib.json"), "sidestep", &files);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     let read = err.matches("read back as `sidestep`\n").count();
@@ -77,34 +85,8 @@ fn learn_then_simulate_a_sequence() {
     let d = tmp("learn");
     let lib = d.join("lib.json");
     for action in ["jump", "spin"] {
-        let ex = d.join(action);
-        let out = figurine(&[
-            "synth",
-            "examples",
-            "--action",
-            action,
-            "--count",
-            "3",
-            "--seed",
-            "5",
-            "--out",
-            ex.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let mut args = vec![
-            "learn",
-            "--library",
-            lib.to_str().unwrap(),
-            "--name",
-            action,
-        ];
-        let files = csvs(&ex);
-        args.extend(files.iter().map(String::as_str));
-        let out = figurine(&args);
+        let files = synth_examples(action, 3, 5, &d.join(action));
+        let out = learn(&lib, action, &files);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{err}");
         // Each example is read back through the device with the library as written.
@@ -122,10 +104,7 @@ fn learn_then_simulate_a_sequence() {
         assert!(text.contains(key), "LIB.json lacks {key}");
     }
     // Learning the same examples under another name warns and names the other action.
-    let files = csvs(&d.join("jump"));
-    let mut args = vec!["learn", "--library", lib.to_str().unwrap(), "--name", "hop"];
-    args.extend(files.iter().map(String::as_str));
-    let out = figurine(&args);
+    let out = learn(&lib, "hop", &csvs(&d.join("jump")));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("warning") && err.contains("`jump`"), "{err}");
     // … and its examples read back as the action learnt first, which the user is told.
