@@ -60,23 +60,15 @@ pub(super) fn mandatory_runs(t: &Tokenized) -> Vec<(Token, usize)> {
 
 /// How many of the strings a pattern is learnt from (the examples and their average) must show
 /// a variation for the pattern to keep it — a token in a column or between columns, a column
-/// an example too short for an edit lacked, a repetition that makes the action cyclic — and
-/// which order statistic the learnt bounds take ([`super::learn`]): of m strings the k-th
-/// extreme with k = m / 4 rounded down, at least one — the most extreme whose expected
-/// quantile, k / m, is at most the quarter that the least of three examples estimates. Three
-/// to six examples give one, the extreme itself; seven to ten give two; eleven to fourteen
-/// three. So one odd performance among many no longer widens the pattern for all of them: a
-/// union of every variation seen grows with each example, and read carried toys as actions.
+/// an example too short for an edit lacked, a repetition that makes the action cyclic: of m
+/// strings k = m / 4 rounded down, at least one — the most whose share, k / m, is at most
+/// the quarter that one of three examples and their average is. Three to six examples give
+/// one: every variation any of them showed; seven to ten give two; eleven to fourteen three.
+/// So one odd performance among many no longer widens the pattern for all of them: a union
+/// of every variation seen grows with each example, and read carried toys as actions. (The
+/// learnt bounds take the examples' lower quartile likewise: `learn::lower_quartile`.)
 pub fn quorum(strings: usize) -> usize {
     (strings / 4).max(1)
-}
-
-/// The `q`-th smallest of `values` (1-based, by `f32::total_cmp`), or the largest when there
-/// are fewer; None when empty: the order statistic [`quorum`] asks for.
-pub fn order_statistic(mut values: Vec<f32>, q: usize) -> Option<f32> {
-    values.sort_by(f32::total_cmp);
-    let k = q.max(1).min(values.len());
-    values.get(k.checked_sub(1)?).copied()
 }
 
 /// Mandatory columns a learnt pattern keeps at least (when its reference has that many).
@@ -582,15 +574,10 @@ mod tests {
     }
 
     #[test]
-    fn the_quorum_is_the_extreme_up_to_six_examples_then_a_lower_quartile() {
+    fn the_quorum_is_one_string_up_to_six_examples_then_a_quarter() {
         // Strings are the examples and their average.
         let q: Vec<usize> = (1..=13).map(|examples| quorum(examples + 1)).collect();
         assert_eq!(q, [1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3]);
-        assert_eq!(order_statistic(vec![3.0, 1.0, 2.0], 1), Some(1.0));
-        assert_eq!(order_statistic(vec![3.0, 1.0, 2.0, 0.5], 2), Some(1.0));
-        // Fewer values than asked: the largest; none: nothing.
-        assert_eq!(order_statistic(vec![3.0, 1.0], 5), Some(3.0));
-        assert_eq!(order_statistic(vec![], 1), None);
     }
 
     #[test]

@@ -15,12 +15,12 @@
 //! them went ([`least_extent`]), the longest stillness inside one ([`longest_hold`]) and the
 //! fewest sub-movements one made ([`fewest_sweeps`]).
 //!
-//! Every variation the pattern keeps and every bound is an order statistic of the examples
-//! ([`super::columns::quorum`]): from three to six examples the extreme (what any one showed,
-//! the least of them), from seven on the lower quartile's, so that a user who teaches more
-//! examples gets a pattern no looser than three would give — taken as a union of all, every
-//! odd performance widened it, and twelve examples read carried toys as actions three times
-//! as often as three did.
+//! The pattern and every bound take the examples' lower quartile, the quantile the least of
+//! three estimates: a variation is kept when a [`super::columns::quorum`] of the strings
+//! shows it (any one, up to six examples), a bound is the [`lower_quartile`] of the examples'
+//! measures (of three, the least). A user who teaches more examples so gets a pattern no
+//! looser than three would give: taken as a union of all, every odd performance widened it,
+//! and twelve examples read carried toys as actions nearly twice as often as three did.
 
 use std::path::PathBuf;
 
@@ -32,7 +32,7 @@ use figurine_recognizer::history::{Run, Sweeps};
 use figurine_recognizer::shape::SHAPE_SCALE;
 use figurine_recognizer::token::STILL;
 
-use super::columns::{learn_regex, order_statistic, quorum};
+use super::columns::{learn_regex, quorum};
 use super::dtw;
 use super::feed::{
     gesture_runs, log_gesture, log_runs, log_runs_and_noise, log_samples, nothing_moved_words,
@@ -58,8 +58,8 @@ pub struct LearnArgs {
     /// Do not also accept the mirror image (left ↔ right) of the examples.
     #[arg(long)]
     pub no_mirror: bool,
-    /// Example logs, one performance each (three are usually enough; from seven on, the pattern
-    /// keeps what a quarter of them show alike, so an odd one is left out).
+    /// Example logs, one performance each (three are usually enough; of more, the pattern keeps
+    /// what a quarter of them show alike, so an odd one is left out).
     #[arg(required = true)]
     pub examples: Vec<PathBuf>,
 }
@@ -129,15 +129,33 @@ fn extent_of_runs(g: &[Run]) -> Extent {
     sums.extent()
 }
 
-/// How many of `n` examples a learnt bound leaves beyond it: the [`quorum`] of the examples
-/// and their average (one of three examples: the bound is their extreme).
+/// How many of `n` examples a learnt count leaves beyond it, and how many alike the pattern
+/// keeps: the [`quorum`] of the examples and their average (one, up to six examples).
 pub fn examples_quorum(n: usize) -> usize {
     quorum(n + 1)
 }
 
+/// The lower quartile of the examples' `values`: the (n + 1) / 4-th least of n (1-based, the
+/// quantile the least of three examples estimates), interpolated between the two it falls
+/// between — the least of three exactly, a quarter of the way from the third least to the
+/// fourth of twelve. None when empty. What a learnt bound takes, so that one odd example
+/// among many does not set it for all.
+pub fn lower_quartile(mut values: Vec<f32>) -> Option<f32> {
+    values.sort_by(f32::total_cmp);
+    let n = values.len();
+    let at = ((n as f32 + 1.0) / 4.0).clamp(1.0, n.max(1) as f32);
+    let below = at as usize;
+    let a = *values.get(below.checked_sub(1)?)?;
+    let share = at - below as f32;
+    Some(match values.get(below) {
+        Some(&b) if share > 0.0 => a + share * (b - a),
+        _ => a,
+    })
+}
+
 /// The longest stillness inside the gestures (each from its first to its last motion),
-/// seconds, as the [`examples_quorum`]-th longest of each gesture's longest (of three: the
-/// longest of all); None when none held still inside.
+/// seconds: the upper quartile ([`lower_quartile`] turned round) of each gesture's longest,
+/// of three examples the longest of all; None when none held still inside.
 pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<f32> {
     let each: Vec<f32> = gestures
         .into_iter()
@@ -149,9 +167,9 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
                 .fold(0.0, f32::max)
         })
         .collect();
-    let q = examples_quorum(each.len());
-    let negated = each.iter().map(|h| -h).collect();
-    order_statistic(negated, q).map(|h| -h).filter(|&h| h > 0.0)
+    lower_quartile(each.iter().map(|h| -h).collect())
+        .map(|h| -h)
+        .filter(|&h| h > 0.0)
 }
 
 /// The fewest sub-movements ([`Sweeps::count`]) the gestures that moved made, as the
@@ -172,7 +190,7 @@ pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Optio
 }
 
 /// The least extent among gestures that moved, dimension by dimension (and the least share of
-/// its own reach that one travelled), each as the [`examples_quorum`]-th least (of three: the
+/// its own reach that one travelled), each as the examples' [`lower_quartile`] (of three: the
 /// least): how far the least of an action's examples went, what the device holds a
 /// performance to ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
 pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
@@ -191,8 +209,7 @@ pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
             }
         })
         .collect();
-    let q = examples_quorum(each.len());
-    let least = |f: fn(&Extent) -> f32| order_statistic(each.iter().map(f).collect(), q);
+    let least = |f: fn(&Extent) -> f32| lower_quartile(each.iter().map(f).collect());
     Some(Extent {
         moved_m: least(|e| e.moved_m)?,
         turned_rad: least(|e| e.turned_rad)?,
@@ -212,16 +229,15 @@ pub fn example_shapes(logs: &[PoseLog]) -> Vec<Shape> {
 /// room for the next performance.
 pub const SHAPE_TOLERANCE_FLOOR: f32 = 0.06;
 
-/// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the
-/// [`examples_quorum`]-th largest |shape − mean| (of three: the largest), weighted by
+/// How far the shapes lie from their mean ([`mean_shape`]) in each dimension: the upper
+/// quartile ([`lower_quartile`] turned round) of |shape − mean|, of three the largest, weighted by
 /// `SHAPE_SCALE` as the device weighs it (`figurine_recognizer::shape::shape_penalty`), at
 /// least [`SHAPE_TOLERANCE_FLOOR`]. None without shapes.
 pub fn shape_tolerance(shapes: &[Shape]) -> Option<Shape> {
     let mean = mean_shape(shapes)?;
-    let q = examples_quorum(shapes.len());
     Some(core::array::from_fn(|k| {
         let negated = shapes.iter().map(|s| -(s[k] - mean[k]).abs()).collect();
-        let far = order_statistic(negated, q).map_or(0.0, |f| -f);
+        let far = lower_quartile(negated).map_or(0.0, |f| -f);
         (SHAPE_SCALE[k] * far).max(SHAPE_TOLERANCE_FLOOR)
     }))
 }
@@ -569,8 +585,10 @@ mod tests {
             .map(|g| moved(std::slice::from_ref(g)))
             .collect();
         each.sort_by(f32::total_cmp);
-        // Twelve examples: the third least of them; three: their least.
-        assert_eq!(moved(&gestures), each[2]);
+        // Twelve examples: a quarter of the way from the third least to the fourth; three:
+        // their least.
+        let quartile = each[2] + 0.25 * (each[3] - each[2]);
+        assert!((moved(&gestures) - quartile).abs() < 1e-6, "{each:?}");
         let three = &gestures[..3];
         let least_of_three = three
             .iter()
@@ -579,6 +597,10 @@ mod tests {
         assert_eq!(moved(three), least_of_three);
         // A shape one example of twelve strays in: the tolerance is how far the others lie
         // from the mean it shifted, not how far it strayed; among three it sets it.
+        assert_eq!(lower_quartile(vec![3.0, 1.0, 2.0]), Some(1.0));
+        assert_eq!(lower_quartile(vec![4.0, 1.0, 2.0, 3.0, 5.0]), Some(1.5));
+        assert_eq!(lower_quartile(vec![7.0]), Some(7.0));
+        assert_eq!(lower_quartile(vec![]), None);
         let mut shapes = vec![[0.1, 0.5, 0.8, 1.0, 0.2, 0.0]; 11];
         shapes.push([0.1, 0.5, 0.8, 1.0, 0.2, 0.9]);
         let shifted = SHAPE_SCALE[5] * 0.9 / 12.0;
