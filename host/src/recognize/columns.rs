@@ -603,6 +603,40 @@ mod tests {
         assert!(accepts(&re, "f.Xn d b"), "{}", re.to_source());
     }
 
+    mod quorum_scales {
+        use super::*;
+        use proptest::prelude::*;
+
+        const NAMES: [&str; 11] = [
+            "f", "b", "u", "d", "uf", "db", "f.Xn", "b.Xp", "d.Xp", "l", "r",
+        ];
+
+        fn strings() -> impl Strategy<Value = Vec<Tokenized>> {
+            let run = (0..NAMES.len(), 0.05f64..0.4)
+                .prop_map(|(i, d)| (parse_token(NAMES[i]).unwrap(), d));
+            prop::collection::vec(prop::collection::vec(run, 2..7), 3)
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig {
+                cases: 200,
+                rng_seed: proptest::test_runner::RngSeed::Fixed(26),
+                ..ProptestConfig::default()
+            })]
+            // Each string taught four times over is taught no differently: the quorum grows by
+            // no more than a quarter of the strings, so what one of three strings showed, four
+            // of twelve show, and three are a quorum of them.
+            #[test]
+            fn the_same_strings_taught_four_times_teach_the_same_pattern(three in strings()) {
+                let twelve: Vec<Tokenized> =
+                    three.iter().flat_map(|s| std::iter::repeat_n(s.clone(), 4)).collect();
+                let once = learn_regex(&three).map(|r| r.to_source());
+                let four_times = learn_regex(&twelve).map(|r| r.to_source());
+                prop_assert_eq!(once.ok(), four_times.ok());
+            }
+        }
+    }
+
     #[test]
     fn a_column_missing_in_the_shortest_example_becomes_optional() {
         let seqs = vec![
