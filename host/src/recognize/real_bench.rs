@@ -167,6 +167,8 @@ pub struct TakeScore {
     pub events: Vec<String>,
     /// Per label, whether an event matched it.
     pub found: Vec<bool>,
+    /// Length of the take's doodle, seconds.
+    pub seconds: f64,
 }
 
 impl TakeScore {
@@ -272,6 +274,8 @@ pub fn score_takes(
             labels: labels.into_iter().map(|(a, _)| a).collect(),
             events: sim.records.iter().map(|r| r.action.clone()).collect(),
             found,
+            seconds: d.log.samples.last().map_or(0.0, |l| l.t)
+                - d.log.samples.first().map_or(0.0, |f| f.t),
         });
     }
     Ok(out)
@@ -284,6 +288,22 @@ pub fn recall_precision<'a>(scores: impl IntoIterator<Item = &'a TakeScore>) -> 
     });
     let ratio = |n: usize, d: usize| if d == 0 { 1.0 } else { n as f64 / d as f64 };
     (ratio(hits, labels), ratio(hits, events))
+}
+
+/// Events per hour on the takes that play no action (a person standing and talking, a
+/// cartwheel…), with their count and the takes' hours: the real-motion twin of `eval rest`.
+pub fn idle_per_hour<'a>(scores: impl IntoIterator<Item = &'a TakeScore>) -> (f64, usize, f64) {
+    let (events, seconds) = scores
+        .into_iter()
+        .filter(|s| s.labels.is_empty())
+        .fold((0, 0.0), |(e, t), s| (e + s.events.len(), t + s.seconds));
+    let hours = seconds / 3600.0;
+    let rate = if hours > 0.0 {
+        events as f64 / hours
+    } else {
+        0.0
+    };
+    (rate, events, hours)
 }
 
 /// Runs `figurine eval real`.
@@ -412,6 +432,12 @@ pub fn report(runs: &[Vec<TakeScore>]) -> String {
         100.0 * recall,
         100.0 * precision
     );
+    let (rate, events, hours) = idle_per_hour(runs.iter().flatten());
+    let _ = writeln!(
+        out,
+        "takes that play no action: {events} events in {:.1} minutes, {rate:.0} per hour",
+        hours * 60.0
+    );
     out
 }
 
@@ -523,6 +549,7 @@ mod tests {
             labels: vec![String::new(); labels],
             events: vec![String::new(); events],
             found: (0..labels).map(|i| i < hits).collect(),
+            seconds: 1.0,
         };
         assert_eq!(recall_precision(&[s(2, 4, 1), s(2, 0, 0)]), (0.25, 0.25));
         assert_eq!(recall_precision(&[]), (1.0, 1.0));
@@ -534,6 +561,7 @@ mod tests {
             labels: labels.iter().map(|l| l.to_string()).collect(),
             events: events.iter().map(|e| e.to_string()).collect(),
             found: found.to_vec(),
+            seconds: 36.0,
         }
     }
 
@@ -559,5 +587,24 @@ mod tests {
         assert_eq!(row, ["t", "turn", "walk", "3", "2/4"], "{text}");
         // One library lists its events by name.
         assert!(report(&[one]).contains("turn run"));
+        // The take that plays nothing: 1 event in 2 × 36 s, 50 an hour.
+        assert!(
+            text.contains("takes that play no action: 1 events in 1.2 minutes, 50 per hour"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn idle_rate_counts_only_takes_without_labels() {
+        let takes = [
+            score(&["walk"], &["walk", "run"], &[true]),
+            score(&[], &["run", "run"], &[]),
+            score(&[], &[], &[]),
+        ];
+        // 2 events in the 72 s of the two takes that play nothing.
+        let (rate, events, hours) = idle_per_hour(&takes);
+        assert_eq!(events, 2);
+        assert!((hours - 0.02).abs() < 1e-12 && (rate - 100.0).abs() < 1e-9);
+        assert_eq!(idle_per_hour(&takes[..1]), (0.0, 0, 0.0));
     }
 }
