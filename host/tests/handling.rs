@@ -103,8 +103,67 @@ fn the_command_line_writes_handling_that_reads_as_nothing() {
     );
     let out = fig(&["synth", "handling", "--kind", "wave", "--out", path]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("known: reposition, lift"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("known: reposition, lift, talk"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Peak speed over 50 ms windows (m/s) and farthest reach from the first sample (m) of a
+/// log's clean trajectory inside `span`.
+fn peak_and_reach(log: &figurine_host::poselog::PoseLog, span: (f64, f64)) -> (f64, f64) {
+    let inside: Vec<_> = log
+        .samples
+        .iter()
+        .filter(|s| s.t >= span.0 && s.t <= span.1)
+        .collect();
+    let dist = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let (mut peak, mut reach) = (0.0f64, 0.0f64);
+    let mut j = 0;
+    for (i, s) in inside.iter().enumerate() {
+        reach = reach.max(dist(s.pos, inside[0].pos));
+        while inside[j].t < s.t - 0.05 {
+            j += 1;
+        }
+        if j < i {
+            peak = peak.max(dist(s.pos, inside[j].pos) / (s.t - inside[j].t));
+        }
+    }
+    (peak, reach)
+}
+
+/// A toy held while its owner talks is generated as wide as the real talker the real-doodle
+/// benchmark holds (the Blender gesture take, its two stretches: the right wrist peaks at
+/// 0.38–0.8 m/s and reaches 19–23 cm from where it began, the hips 0.11–0.19 m/s and 7–11 cm):
+/// over the generator's scales and tempos, some logs lie below the wrist's range and some above
+/// it, and none wanders off (a person who talks stays where they stand). The labels say no
+/// action; the span is marked `talk`.
+#[test]
+fn a_talking_hand_is_generated_across_the_real_talkers_range() {
+    let knobs = Knobs {
+        noise: figurine_host::synth::Range::fixed(0.0),
+        ..Knobs::default()
+    };
+    let (mut peaks, mut reaches) = (Vec::new(), Vec::new());
+    for k in 0..40 {
+        let d = handled(item_seed(37, k), &knobs, Handling::Talk);
+        assert!(d.labels.is_empty());
+        assert_eq!(d.handled.len(), 1);
+        assert_eq!(d.handled[0].action, "talk");
+        let (peak, reach) = peak_and_reach(&d.log, (d.handled[0].start, d.handled[0].end));
+        peaks.push(peak);
+        reaches.push(reach);
+    }
+    let lo = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    assert!(lo(&peaks) < 0.38 && hi(&peaks) > 0.8, "peaks {peaks:?}");
+    assert!(
+        lo(&reaches) < 0.07 && hi(&reaches) > 0.23,
+        "reaches {reaches:?}"
+    );
+    // The farthest a hand can reach: 12 cm at scale 1, twice that at the largest scale, and
+    // the arc's bend beside it.
+    assert!(hi(&reaches) < 0.5, "reaches {reaches:?}");
 }
 
 /// Under a tracker that drifts (noise ×3), a player's three jumps may land only a little

@@ -12,6 +12,7 @@
 //!   precision, recall and F1, and why the unmatched events did not match ([`ExtraKind`]);
 //! - handling that plays no action ([`Handling`]: the toy carried elsewhere, lifted and set
 //!   down; `--isolated` logs of each kind): the share on which nothing is reported;
+//! - a toy held in a hand that talks ([`Handling::Talk`], `--isolated` logs): events per hour;
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
 //!
@@ -35,6 +36,9 @@ use figurine_recognizer::EffortModel;
 
 /// Mixed into the test seed for the handling logs, so they are drawn apart from the gestures.
 const HANDLING_SEED: u64 = 0x4a_4d1e;
+
+/// Mixed into the test seed for the talking logs.
+const TALK_SEED: u64 = 0x7a_1c3e;
 
 /// Arguments of `figurine eval` (the accuracy tables).
 #[derive(Args, Debug)]
@@ -188,6 +192,8 @@ pub struct Figures {
     /// Per kind of handling that plays no action ([`Handling`]): (name, events reported,
     /// logs with any event, logs).
     pub handling: Vec<(String, usize, usize, usize)>,
+    /// A toy held in a hand that talks ([`Handling::Talk`]): every event is a false one.
+    pub talk: TalkCounts,
     /// The counts behind the effort accuracies.
     pub effort_counts: EffortCounts,
 }
@@ -205,6 +211,46 @@ pub struct EffortCounts {
     pub weight: usize,
     /// Both right.
     pub state: usize,
+}
+
+/// Events over logs of a toy held in a hand that talks, and how long the talking lasted: a
+/// rate per hour, as `eval rest` and `eval real` give theirs.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TalkCounts {
+    /// Events reported (every one false).
+    pub events: usize,
+    /// Logs played.
+    pub logs: usize,
+    /// Seconds of talking (the handled spans), summed.
+    pub seconds: f64,
+}
+
+impl TalkCounts {
+    /// Adds `o`'s counts.
+    pub fn add(&mut self, o: TalkCounts) {
+        self.events += o.events;
+        self.logs += o.logs;
+        self.seconds += o.seconds;
+    }
+
+    /// Events per hour of talking (0 when nothing was played).
+    pub fn per_hour(&self) -> f64 {
+        if self.seconds > 0.0 {
+            self.events as f64 * 3600.0 / self.seconds
+        } else {
+            0.0
+        }
+    }
+
+    /// `E events in M minutes, R per hour`.
+    pub fn words(&self) -> String {
+        format!(
+            "{} events in {:.1} minutes, {:.0} per hour",
+            self.events,
+            self.seconds / 60.0,
+            self.per_hour()
+        )
+    }
 }
 
 impl EffortCounts {
@@ -319,7 +365,7 @@ pub fn evaluate(
     };
     f.confusions = conf.into_iter().map(|((a, b), c)| (a, b, c)).collect();
     // Handling: any event is a false one.
-    for (hi, &kind) in Handling::ALL.iter().enumerate() {
+    for (hi, &kind) in Handling::BETWEEN_PLAYS.iter().enumerate() {
         let (mut events, mut loud) = (0, 0);
         for k in 0..args.isolated {
             let seed =
@@ -343,6 +389,25 @@ pub fn evaluate(
         }
         f.handling
             .push((kind.name().to_string(), events, loud, args.isolated));
+    }
+    // Talking with the toy in hand, drawn apart from the kinds above.
+    for k in 0..args.isolated {
+        let seed = synth::sequence::item_seed(args.seed ^ TALK_SEED, k as u64);
+        let d = synth::handled(seed, knobs, Handling::Talk);
+        let evs = run_doodle(&d, &names, &blob, effort)?;
+        f.talk.add(TalkCounts {
+            events: evs.len(),
+            logs: 1,
+            seconds: d.handled.iter().map(|h| h.end - h.start).sum(),
+        });
+        if args.verbose && !evs.is_empty() {
+            let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
+            eprintln!(
+                "talk -> {} (figurine synth handling --kind talk --seed {seed}{})",
+                got.join(" "),
+                args.knob_flags()
+            );
+        }
     }
     // Sequences.
     let (mut matched, mut n_ev, mut n_lab) = (0usize, 0usize, 0usize);
@@ -526,6 +591,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         "Handling that plays no action: silent on {:.1}% ({})",
         100.0 * f.silent(),
         kinds.join(", ")
+    );
+    println!(
+        "Held in a hand that talks, playing no action ({} logs): {}",
+        f.talk.logs,
+        f.talk.words()
     );
     let (med, p90) = quantiles(&f.latencies);
     println!(

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Result};
 
-use super::eval::{evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures};
+use super::eval::{evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures, TalkCounts};
 
 /// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
 pub const TEST_SEED_STEP: u64 = 1000;
@@ -65,7 +65,7 @@ impl PairLine {
 /// The counts under the pairs' shares, summed over the pairs: what a mean of percentages
 /// hides (one more gesture read moves every effort share), and which misreads make the
 /// isolated share (one pair's confusions are a handful; the pairs' sum shows a pattern).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Tally {
     /// Isolated gestures read as the action played.
     pub isolated_ok: usize,
@@ -77,6 +77,8 @@ pub struct Tally {
     pub silent: usize,
     /// Handling logs.
     pub handling: usize,
+    /// A toy held in a hand that talks: events, logs and seconds.
+    pub talk: TalkCounts,
     /// Isolated gestures by (action played, read as or "none"), read as another.
     pub misreads: BTreeMap<(String, String), usize>,
 }
@@ -93,6 +95,7 @@ impl Tally {
             self.silent += n - loud.min(n);
             self.handling += n;
         }
+        self.talk.add(f.talk);
         for (played, read, n) in &f.confusions {
             *self
                 .misreads
@@ -124,14 +127,16 @@ impl Tally {
     pub fn line(&self) -> String {
         format!(
             "counts over the pairs: isolated {} of {} read as played, of them Time right {}, \
-             Weight {}, both {}; handling silent on {} of {} logs",
+             Weight {}, both {}; handling silent on {} of {} logs; held in a hand that \
+             talks, {}",
             self.isolated_ok,
             self.isolated,
             self.effort.time,
             self.effort.weight,
             self.effort.state,
             self.silent,
-            self.handling
+            self.handling,
+            self.talk.words()
         )
     }
 }
@@ -285,6 +290,11 @@ mod tests {
                 state: read - 3,
             },
             handling: vec![("lift".into(), 7, loud, 20)],
+            talk: TalkCounts {
+                events: 3,
+                logs: 20,
+                seconds: 90.0,
+            },
             confusions: vec![
                 ("walk".into(), "run".into(), 10 - ok),
                 ("jump".into(), "none".into(), 1),
@@ -308,7 +318,8 @@ mod tests {
         assert_eq!(
             t.line(),
             "counts over the pairs: isolated 37 of 40 read as played, of them Time right 35, \
-             Weight 33, both 31; handling silent on 33 of 40 logs"
+             Weight 33, both 31; handling silent on 33 of 40 logs; held in a hand that talks, \
+             6 events in 3.0 minutes, 120 per hour"
         );
         assert_eq!(
             t.misreads_line().as_deref(),

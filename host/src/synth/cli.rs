@@ -52,10 +52,10 @@ enum SynthCommand {
         #[command(flatten)]
         knobs: KnobArgs,
     },
-    /// The toy handled without playing an action: carried elsewhere, or lifted, looked at and
-    /// set back down (any event on it is a false one).
+    /// The toy handled without playing an action: carried elsewhere, lifted, looked at and set
+    /// back down, or held in a hand that talks (any event on it is a false one).
     Handling {
-        /// Kind: reposition or lift.
+        /// Kind: reposition, lift or talk.
         #[arg(long)]
         kind: Handling,
         /// Master seed.

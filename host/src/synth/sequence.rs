@@ -270,7 +270,7 @@ pub fn sequence(seed: u64, knobs: &Knobs, count: usize, effort: Option<Effort>) 
     let handle_at = aside.chance(knobs.handling).then(|| {
         (
             aside.index(count + 1),
-            Handling::ALL[aside.index(Handling::ALL.len())],
+            Handling::BETWEEN_PLAYS[aside.index(Handling::BETWEEN_PLAYS.len())],
         )
     });
     let mut p = Performer::new(seed, knobs);
