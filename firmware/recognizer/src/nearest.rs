@@ -39,6 +39,10 @@
 //! that a pause commits while part of its phrase is left unexplained and its motion is unlike
 //! its action's ([`whole_phrase`]): the whole phrase is read as the action whose examples it
 //! moved like (or least unlike), when one reads it within the same share.
+//! And a match that went less far than its action's examples ([`crate::extent`]: a fidget,
+//! for that action) is the action whose pattern reads it within one edit and whose examples
+//! it moved like, when it went as far as those ([`not_that_far`]): each extent bounds its own
+//! action.
 //!
 //! Pauses shorter than [`HOLD_US`] lie inside the phrase: a crouch held low is not two
 //! gestures. The start of the stream bounds a phrase as a pause would (a child who plays right
@@ -251,6 +255,32 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
     if penalty_of(lib, usize::from(c.action), &observed) != Some(SHAPE_CAP) {
         return None;
     }
+    read_alike(lib, hist, c, &observed)
+}
+
+/// Another reading of candidate `c` when its motion did not go as far as its action's
+/// examples ([`crate::extent`]: a fidget, for that action): the action other than `c`'s whose
+/// pattern reads the same tokens within one edit ([`NOT_THAT_FAR_COST`]) and whose examples
+/// the motion moved like, nearest by cost per aligned token. Each action's extent bounds that
+/// action alone: a punch thrown without its wind-up (`f f.Zn b.Zp`), which a run's pattern
+/// matched but which never went as far as a run goes, is the punch whose pattern reads it
+/// bar its wind-up. Whether it went as far as that action's examples is the caller's to ask.
+#[cold]
+#[inline(never)]
+pub fn not_that_far(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candidate> {
+    let observed = observed_shape(hist, c.start, c.end);
+    read_alike(lib, hist, c, &observed).filter(|r| r.cost <= NOT_THAT_FAR_COST)
+}
+
+/// The nearest reading of candidate `c`'s moving tokens within [`LOOSE_SHARE`] by an action
+/// other than `c`'s whose examples moved as `observed` (the runs' shape) did; None when there
+/// is none, or its runs are gone or more than [`NEAREST_MAX_TOKENS`] moving ones.
+fn read_alike(
+    lib: &Library<'_>,
+    hist: &History,
+    c: &Candidate,
+    observed: &Shape,
+) -> Option<Candidate> {
     let mut tok = [STILL; NEAREST_MAX_TOKENS];
     let mut n = 0usize;
     let mut i = c.start;
@@ -268,7 +298,7 @@ pub fn reread(lib: &Library<'_>, hist: &History, c: &Candidate) -> Option<Candid
     let tokens = tok.get(..n)?;
     nearest_alike(
         lib,
-        &observed,
+        observed,
         0,
         tokens,
         c.start,
@@ -402,6 +432,12 @@ pub const OPEN_PHRASE_US: u64 = GAPPED_HOLD_US;
 /// Edits per token a match the automata made may be off another action that re-reads it
 /// ([`reread`]), as (edits, tokens).
 pub const LOOSE_SHARE: (usize, usize) = (1, 2);
+
+/// Most a reading may cost, in half-edits ([`crate::alignment`]), to stand in for a match that
+/// did not go as far as its action's examples ([`not_that_far`]): one edit. Within the loose
+/// share ([`LOOSE_SHARE`]), a run's match over a punch and the kick after it, which went less
+/// far than the run's examples, was read as one throw, more than an edit off both.
+pub const NOT_THAT_FAR_COST: u8 = FULL;
 
 /// Edits per token a stand-alone phrase may be off an action whose examples moved as it did
 /// ([`nearest_action`]), as (edits, tokens): looser than [`LOOSE_SHARE`], because no match
@@ -850,6 +886,51 @@ mod tests {
             ..c
         };
         assert_eq!(reread(&mild, &h, &mild_c), None);
+    }
+
+    #[test]
+    fn a_match_that_went_less_far_than_its_action_is_the_near_action_it_moved_like() {
+        // A punch thrown without its wind-up: forward and back.
+        let (h, thrust) = moved(&[
+            ("f", 15, [0.0, 0.0, 0.5], 0.0),
+            ("b", 15, [0.0, 0.0, -0.5], 0.0),
+        ]);
+        let mut other = thrust;
+        other[5] = -0.3;
+        let shaped = |actions: &[(&[&str], u8)], shapes: &[Shape]| {
+            let blob = seq_library(actions);
+            let shapes: std::vec::Vec<_> = shapes.iter().map(|s| Some(shape_bytes(*s))).collect();
+            crate::pattern::tests::with_shapes(&blob, &shapes)
+        };
+        // 0: the action whose pattern matched (`f b`), whose examples went farther; 1: a punch
+        // `b f b`, one edit off (its wind-up), whose examples moved like this.
+        let blob = shaped(&[(&["f", "b"], 0), (&["b", "f", "b"], 1)], &[other, thrust]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let c = exact_match(0, 1, 2, 0);
+        let r = not_that_far(&lib, &h, &c).unwrap();
+        assert_eq!((r.action, r.start, r.end, r.cost), (1, 1, 2, FULL));
+        // Not when the punch's examples moved otherwise …
+        let unlike = shaped(&[(&["f", "b"], 0), (&["b", "f", "b"], 1)], &[thrust, other]);
+        assert_eq!(
+            not_that_far(&Library::from_bytes(&unlike).unwrap(), &h, &c),
+            None
+        );
+        // … nor when its pattern is two edits off (within the loose share of four tokens,
+        // beyond the one edit a match that was not far enough may be re-read at).
+        let far = shaped(
+            &[(&["f", "b"], 0), (&["b", "f", "b", "b"], 2)],
+            &[other, thrust],
+        );
+        let far = Library::from_bytes(&far).unwrap();
+        assert_eq!(
+            weighted_cost(
+                &far.pattern(1).unwrap(),
+                &[parse_token("f").unwrap(), parse_token("b").unwrap()],
+                255
+            ),
+            Some(2 * FULL)
+        );
+        assert_eq!(not_that_far(&far, &h, &c), None);
     }
 
     #[test]

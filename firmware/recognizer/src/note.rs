@@ -13,6 +13,7 @@
 //! | [`Why::WindUp`] | an event taken into the gesture after it: one stroke against that gesture's first, far smaller — its wind-up | [`crate::follow`] |
 //! | [`Why::Lost`] | its token runs had already left the history | [`crate::history`] |
 //! | [`Why::Reread`] | its motion was plainly unlike its action's examples: reported as the action it moved like | [`crate::nearest`] |
+//! | [`Why::NotThatFar`] | a new event that went less far than its action's examples allow: reported as the action whose pattern reads it within an edit, which it moved like and went as far as | [`crate::nearest`] |
 //! | [`Why::Nearest`] | a stand-alone phrase no pattern matched closely: reported as its nearest action | [`crate::nearest`] |
 //!
 //! The notes change nothing: [`crate::Recognizer::push`] is `push_noted` with notes thrown
@@ -49,6 +50,14 @@ pub enum Why {
     /// Reported as [`Note::action`], its nearest action: a stand-alone phrase no pattern
     /// matched within its bound.
     Nearest,
+    /// Reported as [`Note::action`], though the pattern of action `matched` matched it: it
+    /// went less far than `matched`'s examples (a fidget, for that action), and the reported
+    /// action's pattern reads it within an edit; it moved like that action's examples and
+    /// went as far as they did.
+    NotThatFar {
+        /// The action whose pattern matched.
+        matched: u8,
+    },
 }
 
 /// One decision about a match, with the span of its token runs.

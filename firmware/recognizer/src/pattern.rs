@@ -684,6 +684,18 @@ pub(crate) mod tests {
         out
     }
 
+    /// `blob` (the current version, with its shape table) with action `i`'s least travel set
+    /// to `travel_m` and its least travel share to `share` (0–1).
+    pub fn with_travel(blob: &[u8], i: usize, travel_m: f32, share: f32) -> Vec<u8> {
+        let mut out = blob.to_vec();
+        let n = usize::from(out[4]);
+        let at = out.len() - (n - i) * SHAPE_BYTES;
+        out[at + SHAPE_TRAVEL_AT] =
+            crate::extent::to_byte(travel_m, crate::extent::MOVED_CODE_UNIT_M);
+        out[at + SHAPE_TRAVEL_SHARE_AT] = (share * 255.0) as u8;
+        out
+    }
+
     /// `blob` (the current version, with its shape table) with action `i`'s learnt hold set
     /// to `hold_us` (rounded down to [`HOLD_UNIT_US`]).
     pub fn with_hold(blob: &[u8], i: usize, hold_us: u64) -> Vec<u8> {

@@ -417,6 +417,12 @@ pub fn why_words(n: &Note, names: &[String]) -> String {
              examples and like `{action}`'s",
             name_of(names, matched)
         ),
+        Why::NotThatFar { matched } => format!(
+            "read as `{action}`: `{}`'s pattern matched, but it went less far than its \
+             examples (a fidget, for it); `{action}`'s reads it within an edit, and it moved \
+             like `{action}`'s examples and went as far",
+            name_of(names, matched)
+        ),
         Why::Nearest => format!(
             "offered to `{action}`, its nearest action: no event took this stand-alone phrase"
         ),

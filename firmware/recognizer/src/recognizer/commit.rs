@@ -4,9 +4,11 @@
 //! A candidate the decision stage commits is first re-read when it moved plainly unlike its
 //! action ([`crate::nearest::reread`]), then weighed against the event before it
 //! ([`crate::follow`]) and, when new, against how far its action's examples went
-//! ([`crate::extent`]); a match too brief for any gesture is none. A candidate held at a
-//! pause is reported early ([`Recognizer::report_provisional`]) and revised by the commit if
-//! it changed. Each drop, and each re-read, is a [`Note`] for a reader who asks.
+//! ([`crate::extent`]) — falling short, it is offered to the action its motion did reach
+//! ([`crate::nearest::not_that_far`]); a match too brief for any gesture is none. A
+//! candidate held at a pause is reported early ([`Recognizer::report_provisional`]) and
+//! revised by the commit if it changed. Each drop, and each re-read, is a [`Note`] for a
+//! reader who asks.
 
 use crate::alignment::FULL;
 use crate::bayes::quantise;
@@ -15,13 +17,17 @@ use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::history::HISTORY_RUNS;
 use crate::intake::TICK_S;
-use crate::nearest::reread;
+use crate::nearest::{not_that_far, reread};
 use crate::note::{Note, Why};
 use crate::segment::{Candidate, BRIEF_TURN_RAD, CONTINUE_US, MIN_ACTION_US};
 use crate::sweep::carried;
 use crate::token::STILL;
 
 use super::{ActionEvent, Recognizer, Sink};
+
+/// What committing a candidate emits ([`Recognizer::outcome`]): the event, whether it revises
+/// the held one, and the held event after it; or why there is none.
+type Outcome = Result<(Held, bool, Option<Held>), Why>;
 
 impl<'lib> Recognizer<'lib> {
     /// Reports the pending candidate `p` before it is committed (once): the figurine has
@@ -34,7 +40,8 @@ impl<'lib> Recognizer<'lib> {
             return;
         }
         let before = self.held;
-        if let Ok((ev, continues, held)) = self.outcome(&p, before) {
+        let (p, outcome) = self.reaching_outcome(p, before);
+        if let Ok((ev, continues, held)) = outcome {
             self.provisional = Some((p, before, continues));
             self.held = held;
             self.report_floor = self.phrase_floor;
@@ -48,11 +55,7 @@ impl<'lib> Recognizer<'lib> {
     /// it ([`crate::follow`]); or why
     /// there is none: `c` is too brief, is the held event's settling, or is a new event whose
     /// motion did not go as far as its action's examples ([`far_enough`]: a fidget).
-    pub(super) fn outcome(
-        &self,
-        c: &Candidate,
-        held: Option<Held>,
-    ) -> Result<(Held, bool, Option<Held>), Why> {
+    pub(super) fn outcome(&self, c: &Candidate, held: Option<Held>) -> Outcome {
         let (ev, (from, to)) = self.event_of(c)?;
         // Only a new event is held to its action's extent and sub-movements; a continuation's
         // went before. A fidget seems to go as far as the tracker's noise takes it besides.
@@ -103,6 +106,18 @@ impl<'lib> Recognizer<'lib> {
         h.end_run = c.end;
         h.acc.merge(&ev.acc);
         Ok((h, true, Some(h)))
+    }
+
+    /// [`Recognizer::outcome`] of `c`, or, when `c` went less far than its action's examples,
+    /// of the action whose pattern reads it within an edit and whose examples it moved like
+    /// and went as far as ([`not_that_far`]); with the candidate that outcome is of.
+    fn reaching_outcome(&self, c: Candidate, held: Option<Held>) -> (Candidate, Outcome) {
+        match self.outcome(&c, held) {
+            Err(Why::NotFarEnough) => not_that_far(&self.library, self.front.history(), &c)
+                .and_then(|r| self.outcome(&r, held).ok().map(|o| (r, Ok(o))))
+                .unwrap_or((c, Err(Why::NotFarEnough))),
+            o => (c, o),
+        }
     }
 
     /// The event `c` would be, and the runs of its motion phrase; or why there is none (its
@@ -211,7 +226,11 @@ impl<'lib> Recognizer<'lib> {
             Some((_, _, false)) => None,
             None => self.held,
         };
-        let outcome = self.outcome(&c, before);
+        let (reached, outcome) = self.reaching_outcome(c, before);
+        if reached != c {
+            out.note(|| self.note_of(&reached, Why::NotThatFar { matched: c.action }));
+        }
+        let c = reached;
         self.bank.reset();
         self.decider.clear();
         // The pause's answer was about the match now committed: what is pending next is
@@ -557,6 +576,47 @@ mod tests {
         assert!(notes.iter().any(|n| n.why == Why::OneSweep), "{notes:?}");
         let (ev, notes) = run_noted(&lib, &pushes_forward(3));
         assert_eq!(ev.len(), 1, "{ev:?} {notes:?}");
+    }
+
+    #[test]
+    fn a_match_that_went_less_far_than_its_action_is_the_near_action_that_went_as_far() {
+        use crate::pattern::tests::{with_extents, with_travel};
+        // A jab (25 cm out and back) that a dash's pattern `f b` matches exactly, and a
+        // punch's `b f b` reads bar its wind-up; every shape alike.
+        let blob = seq_library(&[(&["f", "b"], 0), (&["b", "f", "b"], 0)]);
+        let jab = thrust_and_return(0.1);
+        // Which of the two ended, in every example, as far from where it began as it went.
+        let lib = |travels: [bool; 2]| {
+            let mut l = with_extents(&blob, &[(0.3, 0.0), (0.1, 0.0)]);
+            for (i, _) in travels.iter().enumerate().filter(|(_, t)| **t) {
+                l = with_travel(&l, i, 0.3, 1.0);
+            }
+            l
+        };
+        // Every dash's example ended as far from where it began as it went: the jab, back
+        // where it began, is no dash; it went as far as the punch's examples.
+        let (ev, notes) = run_noted(&Library::from_bytes(&lib([true, false])).unwrap(), &jab);
+        assert_eq!(
+            ev.iter().map(|e| e.action).collect::<Vec<_>>(),
+            [1],
+            "{notes:?}"
+        );
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.action == 1 && n.why == Why::NotThatFar { matched: 0 }),
+            "{notes:?}"
+        );
+        // A dash that need not travel: the dash it is.
+        let ev = run(&Library::from_bytes(&lib([false, false])).unwrap(), &jab);
+        assert_eq!(ev.iter().map(|e| e.action).collect::<Vec<_>>(), [0]);
+        // Not as far as either's examples went (the punch's travelled too): nothing.
+        let (ev, notes) = run_noted(&Library::from_bytes(&lib([true, true])).unwrap(), &jab);
+        assert_eq!(ev, []);
+        assert!(
+            notes.iter().any(|n| n.why == Why::NotFarEnough),
+            "{notes:?}"
+        );
     }
 
     #[test]
