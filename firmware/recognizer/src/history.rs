@@ -12,6 +12,7 @@
 //! RAM: `HISTORY_RUNS × 296` bytes ≈ 11.6 KiB.
 
 use crate::features::Accum;
+use crate::fmath;
 use crate::token::{Token, STILL};
 
 /// Runs kept.
@@ -218,6 +219,33 @@ impl History {
             .flatten()
     }
 
+    /// How far below the lowest rest before it the figurine ended at the end of run `end`, m:
+    /// below where run `start` began and below either end of every STILL run before that
+    /// which the ring still holds (negative when one of them lies lower; 0 when none is held).
+    /// A crouch's descent ends lower than any rest it set off from; a toy set back down after
+    /// a lift ends where it rested before. A rest's lower end, because the tokens lag the
+    /// motion: a lift's first centimetres are still inside the rest before it.
+    pub fn sunk_below_rests(&self, start: u32, end: u32) -> f32 {
+        // Heights relative to the end of `end`, walking back run by run.
+        let mut h = 0.0f32;
+        let mut lowest: Option<f32> = None;
+        let mut low = |x: f32| lowest = Some(lowest.map_or(x, |l| fmath::min(l, x)));
+        let mut i = end;
+        for _ in 0..HISTORY_RUNS {
+            let Some(r) = self.get(i) else { break };
+            let rest = r.token == STILL && i.wrapping_sub(start) > end.wrapping_sub(start);
+            if rest {
+                low(h);
+            }
+            h -= r.acc.rise;
+            if rest || i == start {
+                low(h);
+            }
+            i = i.wrapping_sub(1);
+        }
+        lowest.unwrap_or(0.0)
+    }
+
     /// Sum of the feature accumulators of runs `from..=to` (those still held).
     pub fn accum(&self, from: u32, to: u32) -> Accum {
         let mut acc = Accum::new();
@@ -250,6 +278,27 @@ mod tests {
         assert_eq!(h.accum(98, 99).n, 3);
         h.clear();
         assert!(h.get(99).is_none());
+    }
+
+    #[test]
+    fn a_descent_is_measured_against_the_lowest_rest_before_it() {
+        // Runs as (token, rise m): rest, up 10 cm (its onset 2 cm inside the rest), rest at
+        // the top, down 12 cm.
+        let mut h = History::new();
+        for (token, rise) in [(STILL, 0.02), (1, 0.08), (STILL, 0.0), (2, -0.12)] {
+            let mut a = Accum::new();
+            a.rise = rise;
+            h.open(token, (0, 0), a);
+        }
+        // From the top it ended 2 cm below where it rested before the lift: the rest's lower
+        // end, not the height it had risen to when the rest ended.
+        assert!((h.sunk_below_rests(3, 3) - 0.02).abs() < 1e-6);
+        // The whole lift began where it rested: no lower than that.
+        assert!((h.sunk_below_rests(1, 3) - 0.02).abs() < 1e-6);
+        // Ending at the top is 10 cm above the rest before it.
+        assert!((h.sunk_below_rests(1, 1) + 0.10).abs() < 1e-6);
+        // Runs no longer held tell nothing.
+        assert_eq!(h.sunk_below_rests(99, 99), 0.0);
     }
 
     #[test]

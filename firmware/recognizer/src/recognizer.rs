@@ -256,11 +256,12 @@ impl<'lib> Recognizer<'lib> {
                             )
                         })
                         .unwrap_or(c);
-                    self.commit(c, out);
                     // What moved after it while it was held (a turn begun while a run's match
                     // waited for its next stride; a crouch right after a wave's last stroke) is
                     // read afresh, as after a commit at a token.
-                    self.feed_from(self.floor, out);
+                    if self.commit(c, out) {
+                        self.feed_from(self.floor, out);
+                    }
                 } else if let Some(p) = self
                     .decider
                     .pending()
@@ -399,8 +400,13 @@ impl<'lib> Recognizer<'lib> {
             match self.decider.offer(best, self.floor) {
                 Decision::Wait => i = i.wrapping_add(1),
                 Decision::Commit(c) => {
-                    self.commit(c, out);
-                    i = self.floor;
+                    if self.commit(c, out) {
+                        i = self.floor;
+                    } else {
+                        // Left open: the match ending here is weighed as if none had been.
+                        self.decider.offer(best, self.floor);
+                        i = i.wrapping_add(1);
+                    }
                 }
             }
         }

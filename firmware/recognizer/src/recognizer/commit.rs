@@ -5,14 +5,16 @@
 //! action ([`crate::nearest::reread`]), then weighed against the event before it
 //! ([`crate::follow`]) and, when new, against how far its action's examples went
 //! ([`crate::extent`]) — falling short, it is offered to the action its motion did reach
-//! ([`crate::nearest::not_that_far`]); a match too brief for any gesture is none. A
-//! candidate held at a pause is reported early ([`Recognizer::report_provisional`]) and
-//! revised by the commit if it changed. Each drop, and each re-read, is a [`Note`] for a
-//! reader who asks.
+//! ([`crate::nearest::not_that_far`]); a match too brief for any gesture is none. A commit
+//! consumes the match's runs, but for a match dropped as short of its action that ended below
+//! every rest before it ([`crate::history::History::sunk_below_rests`]): a descent whose rise
+//! is still to come is left to a longer match. A candidate held at a pause is reported early
+//! ([`Recognizer::report_provisional`]) and revised by the commit if it changed. Each drop,
+//! and each re-read, is a [`Note`] for a reader who asks.
 
 use crate::alignment::FULL;
 use crate::bayes::quantise;
-use crate::extent::{far_enough, noise_reach, span_extent};
+use crate::extent::{far_enough, noise_reach, span_extent, FIDGET_MOVED_M};
 use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::history::HISTORY_RUNS;
@@ -206,8 +208,9 @@ impl<'lib> Recognizer<'lib> {
     /// report of another candidate it took over (nothing, when it is that reported candidate).
     /// A cyclic action's event stays held so that its next cycle can continue it. A candidate
     /// whose shape is as unlike its action's as the penalty measures is first offered to
-    /// [`reread`].
-    pub(super) fn commit(&mut self, c: Candidate, out: &mut impl Sink) {
+    /// [`reread`]. False when it consumed none of the runs (the automata and the floor stay
+    /// where they were); true otherwise.
+    pub(super) fn commit(&mut self, c: Candidate, out: &mut impl Sink) -> bool {
         // After a provisional report, `c` is judged against what the consumer had before it:
         // the held event as it was, if the report continued it; nothing, if the report was a
         // new event (which `c` replaces).
@@ -231,6 +234,18 @@ impl<'lib> Recognizer<'lib> {
             out.note(|| self.note_of(&reached, Why::NotThatFar { matched: c.action }));
         }
         let c = reached;
+        if provisional.is_none()
+            && matches!(outcome, Err(Why::NotFarEnough))
+            && self.front.history().sunk_below_rests(c.start, c.end) > FIDGET_MOVED_M
+        {
+            // A descent that ended lower than any rest before it has its rise still to come:
+            // a crouch held low whose descent another action's pattern read. It stays open
+            // for a longer match to take it whole.
+            out.note(|| self.note_of(&c, Why::NotFarEnough));
+            self.decider.clear();
+            self.hold = None;
+            return false;
+        }
         self.bank.reset();
         self.decider.clear();
         // The pause's answer was about the match now committed: what is pending next is
@@ -243,7 +258,7 @@ impl<'lib> Recognizer<'lib> {
             Ok(o) => o,
             Err(why) => {
                 out.note(|| self.note_of(&c, why));
-                return;
+                return true;
             }
         };
         if let Some(b) = before.filter(|b| revises && b.action != ev.action) {
@@ -266,6 +281,7 @@ impl<'lib> Recognizer<'lib> {
             Some((_, _, false)) => self.emit_held(ev, true, out),
             None => self.emit_held(ev, revises, out),
         }
+        true
     }
 
     pub(super) fn emit_held(&mut self, h: Held, revises: bool, out: &mut impl Sink) {
@@ -617,6 +633,48 @@ mod tests {
             notes.iter().any(|n| n.why == Why::NotFarEnough),
             "{notes:?}"
         );
+    }
+
+    /// What a library of 0 "jump" `d+`, whose examples went 20 cm and landed 30 cm ahead, and
+    /// 1 "crouch" `d+ u+` reads from `samples`: its events, and whether the jump's match was
+    /// dropped as going less far than its examples.
+    fn read_jump_and_crouch(samples: &[crate::intake::Sample]) -> (Vec<ActionEvent>, bool) {
+        let blob = seq_library(&[(&["d"], 0), (&["d", "u"], 0)]);
+        let blob = crate::pattern::tests::with_extents(&blob, &[(0.2, 0.01), (0.01, 0.01)]);
+        let blob = crate::pattern::tests::with_travel(&blob, 0, 0.3, 0.5);
+        let (ev, notes) = run_noted(&Library::from_bytes(&blob).unwrap(), samples);
+        let dropped = notes
+            .iter()
+            .any(|n| n.action == 0 && n.why == Why::NotFarEnough);
+        (ev, dropped)
+    }
+
+    #[test]
+    fn a_descent_that_ended_below_every_rest_waits_for_its_rise() {
+        // Held low longer than any hold waits: at the pause the jump's match of the descent
+        // is committed and dropped (it landed nowhere), but the crouch is still to come.
+        let (ev, dropped) = read_jump_and_crouch(&crouch_held_low(1.2));
+        assert!(dropped);
+        assert_eq!(
+            ev.iter().map(|e| (e.action, e.revises)).collect::<Vec<_>>(),
+            [(1, false)],
+            "{ev:?}"
+        );
+        // From the descent (0.6–1.0 s; pitched in its first half, which `d` leaves out) to
+        // the rise (2.2–2.6 s).
+        assert!(
+            ev[0].start_us < 1_000_000 && ev[0].end_us > 2_500_000,
+            "{ev:?}"
+        );
+    }
+
+    #[test]
+    fn a_toy_set_back_down_where_it_rested_leaves_its_descent_behind() {
+        // Set down to the height it rested at before the lift: the jump's dropped match of
+        // the set-down is consumed, and the next lift is no crouch's rise.
+        let (ev, dropped) = read_jump_and_crouch(&lifted_set_down_lifted());
+        assert!(dropped);
+        assert_eq!(ev, []);
     }
 
     #[test]

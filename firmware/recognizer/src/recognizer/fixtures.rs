@@ -180,6 +180,29 @@ pub(crate) fn crouch_held_low(hold_s: f32) -> Vec<Sample> {
         .collect()
 }
 
+/// Lifted 15 cm (0.4 s), held up for a second, set back down where it rested (0.4 s), held
+/// for a second, lifted again (0.4 s), at 120 Hz: a toy picked up, looked at, put down and
+/// picked up again.
+pub(crate) fn lifted_set_down_lifted() -> Vec<Sample> {
+    let rate = 120.0f32;
+    let (still, stroke, hold) = (0.6f32, 0.4f32, 1.0f32);
+    let total = 2.0 * still + 3.0 * stroke + 2.0 * hold;
+    (0..(total * rate) as u32)
+        .map(|i| {
+            let t = i as f32 / rate;
+            let up = ramp((t - still) / stroke);
+            let down = ramp((t - still - stroke - hold) / stroke);
+            let again = ramp((t - still - 2.0 * (stroke + hold)) / stroke);
+            Sample {
+                seq: i,
+                t_us: (t * 1e6) as u64,
+                pos: [0.3, 1.0 + 0.15 * (up - down + again), 0.0],
+                quat: [1.0, 0.0, 0.0, 0.0],
+            }
+        })
+        .collect()
+}
+
 /// Quick strokes (0.12 s each, 5 cm, along `dirs`), 0.15 s apart, played right after the
 /// stream starts; then still.
 pub(crate) fn quick_strokes(dirs: &[[f32; 3]]) -> Vec<Sample> {
