@@ -234,31 +234,26 @@ impl<'lib> Recognizer<'lib> {
             out.note(|| self.note_of(&reached, Why::NotThatFar { matched: c.action }));
         }
         let c = reached;
-        if provisional.is_none()
+        // A descent that ended lower than any rest before it has its rise still to come: a
+        // crouch held low whose descent another action's pattern read and dropped. Its runs
+        // stay open for a longer match to take it whole; any other match's are consumed.
+        let open = provisional.is_none()
             && matches!(outcome, Err(Why::NotFarEnough))
-            && self.front.history().sunk_below_rests(c.start, c.end) > FIDGET_MOVED_M
-        {
-            // A descent that ended lower than any rest before it has its rise still to come:
-            // a crouch held low whose descent another action's pattern read. It stays open
-            // for a longer match to take it whole.
-            out.note(|| self.note_of(&c, Why::NotFarEnough));
-            self.decider.clear();
-            self.hold = None;
-            return false;
-        }
-        self.bank.reset();
+            && self.front.history().sunk_below_rests(c.start, c.end) > FIDGET_MOVED_M;
         self.decider.clear();
         // The pause's answer was about the match now committed: what is pending next is
         // weighed afresh.
         self.hold = None;
-        self.floor = c.end.wrapping_add(1);
-        // Its runs are consumed either way; a too-brief one is not emitted (and a report of
-        // another candidate stands).
+        if !open {
+            self.bank.reset();
+            self.floor = c.end.wrapping_add(1);
+        }
+        // A too-brief match is not emitted (and a report of another candidate stands).
         let (ev, revises, held) = match outcome {
             Ok(o) => o,
             Err(why) => {
                 out.note(|| self.note_of(&c, why));
-                return true;
+                return !open;
             }
         };
         if let Some(b) = before.filter(|b| revises && b.action != ev.action) {
