@@ -203,6 +203,17 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
             || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned))
 }
 
+/// Whether a span that `went` so far reached the whole of the `least` extent an action's
+/// examples went — not a share of it, as [`far_enough`] asks — in a dimension that carries
+/// the action (at least [`CARRY_SHARE`] of the other's): what a match briefer than any
+/// gesture must show to be one ([`crate::segment::MIN_ACTION_US`]).
+pub fn went_as_far(went: Extent, least: Extent) -> bool {
+    let moved = least.moved_m;
+    let turned = ARM_M * least.turned_rad;
+    (moved >= CARRY_SHARE * turned && went.moved_m >= moved)
+        || (turned >= CARRY_SHARE * moved && went.turned_rad >= least.turned_rad)
+}
+
 /// A learnt extent `x` (in the code's `unit`) as the library's byte: 1 + 16·log2(x / unit),
 /// rounded, 1–255 (0 is "not learnt").
 pub fn to_byte(x: f32, unit: f32) -> u8 {
@@ -298,6 +309,27 @@ mod tests {
         let e = span_extent(&h, first, last);
         assert!((e.moved_m - libm::hypotf(0.1, 0.1)).abs() < 1e-4, "{e:?}");
         assert!((span_extent(&h, last, last).moved_m - 0.1).abs() < 1e-4);
+    }
+
+    #[test]
+    fn as_far_is_the_whole_of_the_least_example_in_a_carrying_dimension() {
+        let sidestep = ext(0.08, 0.1);
+        let turn = ext(0.02, 1.6);
+        let throw = ext(0.1, 0.8);
+        // A sidestep flicked as far as its least example, or farther: as far.
+        assert!(went_as_far(ext(0.08, 0.0), sidestep));
+        assert!(went_as_far(ext(0.12, 0.0), sidestep));
+        // Far enough for an event (a share of it), but not as far.
+        assert!(far_enough(ext(0.03, 0.0), sidestep, QUIET));
+        assert!(!went_as_far(ext(0.03, 0.0), sidestep));
+        // A turn is carried by its rotation: a wrist's twist that moves 5 cm and turns 1 rad
+        // is not as far as a turn whose least example turned 1.6; the whole of it is.
+        assert!(!went_as_far(ext(0.05, 1.0), turn));
+        assert!(went_as_far(ext(0.0, 1.6), turn));
+        // A throw is carried by both: either reaching its least will do.
+        assert!(went_as_far(ext(0.1, 0.2), throw));
+        assert!(went_as_far(ext(0.02, 0.8), throw));
+        assert!(!went_as_far(ext(0.09, 0.7), throw));
     }
 
     #[test]

@@ -8,8 +8,9 @@
 //!
 //! # Library blob layout, version [`LIBRARY_VERSION`] (all integers little-endian)
 //! ```text
-//! 0   4   magic "FGL" + version byte (10; version 9, whose shape table has only the first 18
-//!         bytes of each entry, is still read and its sub-movements are not known; version 8,
+//! 0   4   magic "FGL" + version byte (11; version 10, whose shape table has only the first 19
+//!         bytes of each entry, is still read and its briefest example is not known; version
+//!         9, with only 18, is still read and its sub-movements are not known either; version 8,
 //!         with only 17, is still read and its travel shares are not known either; version 7,
 //!         with only 16, is still read and its travels are not known either; version 6, with
 //!         only 15, is still read and its holds are not known either; version 5, with
@@ -30,9 +31,9 @@
 //! +36 2n  symbol of each position 1..=n (token code < STILL, optionally one wildcard flag:
 //!         `token::ANY_ROT` or `token::ANY_LIN`)
 //! +.. 8(n+1) follow set of each state 0..=n
-//! then the shape table, 19 bytes per action in record order (the mean of its examples'
+//! then the shape table, 20 bytes per action in record order (the mean of its examples'
 //! shapes, `features::Shape`, how far they lay from it, how far the least of them went, how
-//! long they held still inside and how few sub-movements they made):
+//! long they held still inside, how few sub-movements they made and how briefly they moved):
 //! +0  3   mean |velocity| along left, up, front (object frame), each as a share of the mean
 //!         speed, × 255 rounded
 //! +3  1   0 = shape unknown (all fifteen bytes are zero); otherwise shape known (learnt
@@ -55,6 +56,8 @@
 //!         farthest displacement), × 255 rounded; 0 = none or not known
 //! +18 1   the fewest sub-movements an example made (`history::Sweeps::count`, counted
 //!         against the noise), at most 255; 0 = none or not known
+//! +19 1   how long the briefest example moved, from its first motion to its last, in
+//!         [`HOLD_UNIT_US`]; 0 = not known
 //! ```
 //! `shift`, `loops` and `extra` are redundant with `follow` (the loader checks they agree);
 //! they make the forward transition `T(D) = ((D≪1) & shift) | (D & loops) | ⋃_{i ∈ D∩extra}
@@ -72,9 +75,13 @@ pub const MAX_POSITIONS: usize = 32;
 /// Maximum edits per action.
 pub const MAX_EDITS: usize = 3;
 /// Library blob format version written by the host.
-pub const LIBRARY_VERSION: u8 = 10;
+pub const LIBRARY_VERSION: u8 = 11;
 /// Bytes per action in the shape table.
-pub const SHAPE_BYTES: usize = 19;
+pub const SHAPE_BYTES: usize = 20;
+/// Bytes per action in a version 10 shape table (no briefest example).
+const SHAPE_BYTES_V10: usize = 19;
+/// Offset of the briefest example's duration in a shape-table entry.
+const SHAPE_BRIEF_AT: usize = 19;
 /// Bytes per action in a version 9 shape table (no sub-movements).
 const SHAPE_BYTES_V9: usize = 18;
 /// Offset of the fewest sub-movements in a shape-table entry.
@@ -113,7 +120,7 @@ pub const LIBRARY_HEADER: usize = 8;
 pub const fn record_size(n: usize) -> usize {
     36 + 2 * n + 8 * (n + 1)
 }
-/// Largest valid library blob, bytes (12,264).
+/// Largest valid library blob, bytes (12,296).
 pub const MAX_LIBRARY_BYTES: usize =
     LIBRARY_HEADER + MAX_ACTIONS * (record_size(MAX_POSITIONS) + SHAPE_BYTES);
 
@@ -329,6 +336,7 @@ impl<'a> Library<'a> {
             7 => SHAPE_BYTES_V7,
             8 => SHAPE_BYTES_V8,
             9 => SHAPE_BYTES_V9,
+            10 => SHAPE_BYTES_V10,
             _ => SHAPE_BYTES,
         };
         if stride > 0 {
@@ -435,6 +443,18 @@ impl<'a> Library<'a> {
         }
         let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_SWEEPS_AT;
         self.bytes.get(at).copied().unwrap_or(0)
+    }
+
+    /// How long the briefest of action `i`'s examples moved, µs, from its first motion to its
+    /// last (0: not learnt, a library older than version 11).
+    pub fn briefest_us(&self, i: usize) -> u64 {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_BRIEF_AT {
+            return 0;
+        }
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_BRIEF_AT;
+        self.bytes
+            .get(at)
+            .map_or(0, |&b| u64::from(b) * HOLD_UNIT_US)
     }
 
     /// The longest stillness inside any of action `i`'s examples, µs: how long a performance
@@ -696,6 +716,16 @@ pub(crate) mod tests {
         out
     }
 
+    /// `blob` (the current version, with its shape table) with action `i`'s briefest example
+    /// set to `briefest_us` (rounded down to [`HOLD_UNIT_US`]).
+    pub fn with_briefest(blob: &[u8], i: usize, briefest_us: u64) -> Vec<u8> {
+        let mut out = blob.to_vec();
+        let n = usize::from(out[4]);
+        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_BRIEF_AT;
+        out[at] = (briefest_us / HOLD_UNIT_US).min(255) as u8;
+        out
+    }
+
     /// `blob` (the current version, with its shape table) with action `i`'s learnt hold set
     /// to `hold_us` (rounded down to [`HOLD_UNIT_US`]).
     pub fn with_hold(blob: &[u8], i: usize, hold_us: u64) -> Vec<u8> {
@@ -861,6 +891,21 @@ pub(crate) mod tests {
         let lib = Library::from_bytes(&v9).unwrap();
         assert_eq!(lib.least_sweeps(0), 0);
         assert!(lib_extent(&v9).is_some_and(|e| (e.travel_share - 0.6).abs() < 1e-6));
+        // The briefest example's moving time, in the hold's unit (0: not known, as in a
+        // version 10 library, whose entries end at the sub-movements).
+        assert_eq!(Library::from_bytes(&ext).unwrap().briefest_us(0), 0);
+        ext[entry + SHAPE_BRIEF_AT] = 18;
+        let lib = Library::from_bytes(&ext).unwrap();
+        assert_eq!(
+            (lib.briefest_us(0), lib.briefest_us(1), lib.briefest_us(9)),
+            (180_000, 0, 0)
+        );
+        let mut v10 = v1.clone();
+        v10[3] = 10;
+        v10.extend(&ext[entry..entry + SHAPE_BYTES_V10]);
+        v10.extend([0; SHAPE_BYTES_V10]);
+        let lib = Library::from_bytes(&v10).unwrap();
+        assert_eq!((lib.briefest_us(0), lib.least_sweeps(0)), (0, 4));
         // The extents, both known or neither.
         assert_eq!(lib_extent(&tol), None);
         let mut ext = tol.clone();

@@ -12,8 +12,9 @@
 //!
 //! Besides its pattern, an action keeps what its examples say of how it moves: its motion
 //! shape and how much that varied ([`mean_shape`], [`shape_tolerance`]), how far the least of
-//! them went ([`least_extent`]), the longest stillness inside one ([`longest_hold`]) and the
-//! fewest sub-movements one made ([`fewest_sweeps`]).
+//! them went ([`least_extent`]), the longest stillness inside one ([`longest_hold`]), the
+//! fewest sub-movements one made ([`fewest_sweeps`]) and how briefly the quickest moved
+//! ([`briefest`]).
 //!
 //! The pattern and every bound take the examples' lower quartile, the quantile the least of
 //! three estimates: a variation is kept when a [`super::columns::quorum`] of the strings
@@ -172,6 +173,19 @@ pub fn longest_hold<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option
         .filter(|&h| h > 0.0)
 }
 
+/// How long the briefest gesture moved, from its first motion to its last, seconds: the
+/// examples' [`lower_quartile`] (of three, the briefest); None without one. A performance
+/// half as long that goes as far as the least of them is a quick one, not a flicker
+/// (`figurine_recognizer::recognizer`'s floor, [`figurine_recognizer::segment::MIN_ACTION_US`]).
+pub fn briefest<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<f32> {
+    let each: Vec<f32> = gestures
+        .into_iter()
+        .filter_map(|g| Some((g.first()?.start.1, g.last()?.end.1)))
+        .map(|(a, b)| b.saturating_sub(a) as f32 * 1e-6)
+        .collect();
+    lower_quartile(each)
+}
+
 /// The fewest sub-movements ([`Sweeps::count`]) the gestures that moved made, as the
 /// [`examples_quorum`]-th fewest (of three: the fewest any made); None without one.
 pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<u8> {
@@ -306,7 +320,8 @@ pub fn learn_action(
     .with_shape_tolerance(shape_tolerance(&shapes))
     .with_extent(least_extent(read.iter().map(|e| &e.runs[..])))
     .with_hold(longest_hold(read.iter().map(|e| &e.runs[..])))
-    .with_sweeps(fewest_sweeps(read.iter().map(|e| &e.runs[..])));
+    .with_sweeps(fewest_sweeps(read.iter().map(|e| &e.runs[..])))
+    .with_briefest(briefest(read.iter().map(|e| &e.runs[..])));
     Ok(entry)
 }
 
@@ -408,8 +423,12 @@ pub fn run(args: &LearnArgs) -> Result<()> {
     let pushes = entry.sweeps.map_or(String::new(), |n| {
         format!(", each example {n} or more sub-movements")
     });
+    // How quick a performance may be and still be one (`figurine_recognizer::recognizer`).
+    let quick = entry.briefest_s.map_or(String::new(), |s| {
+        format!(", the briefest moved for {s:.2} s")
+    });
     println!(
-        "{}: {}  (max {} edits{shape}{pushes})",
+        "{}: {}  (max {} edits{shape}{pushes}{quick})",
         entry.name, entry.regex, entry.max_edits
     );
     lib.upsert(entry);
@@ -570,6 +589,40 @@ mod tests {
             assert_eq!(made(&carried.log), 1, "a carry, seed {seed}");
         }
         assert_eq!(fewest_sweeps(std::iter::empty::<&[Run]>()), None);
+    }
+
+    #[test]
+    fn the_briefest_example_is_its_first_motion_to_its_last() {
+        // Each example as the device reads it, from its first moving run to its last.
+        let logs = example_logs(Action::Punch, 4);
+        let each: Vec<f32> = logs
+            .iter()
+            .map(|log| briefest([&log_gesture(log)[..]]).unwrap())
+            .collect();
+        let entry = learn_action("punch", &logs, None, false).unwrap();
+        let least = each.iter().copied().fold(f32::INFINITY, f32::min);
+        assert_eq!(entry.briefest_s, Some(least), "{each:?}");
+        // A punch lasts tenths of a second, not milliseconds or seconds.
+        assert!((0.1..1.5).contains(&least), "{each:?}");
+        // Sudden examples are briefer than sustained ones of the same action.
+        let played = |time: synth::TimeClass| {
+            let effort = synth::Effort::new(time, synth::WeightClass::Neutral);
+            let logs: Vec<PoseLog> =
+                synth::examples(4, &Knobs::default(), Action::Punch, 3, Some(effort))
+                    .into_iter()
+                    .map(|d| d.log)
+                    .collect();
+            learn_action("punch", &logs, None, false)
+                .unwrap()
+                .briefest_s
+                .unwrap()
+        };
+        let (sudden, sustained) = (
+            played(synth::TimeClass::Sudden),
+            played(synth::TimeClass::Sustained),
+        );
+        assert!(sudden < sustained, "{sudden} {sustained}");
+        assert_eq!(briefest(std::iter::empty::<&[Run]>()), None);
     }
 
     #[test]

@@ -101,6 +101,12 @@ pub struct ActionEntry {
     /// learnt before it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sweeps: Option<u8>,
+    /// How long the briefest example moved, from its first motion to its last, s: a match
+    /// briefer than the device's floor for any gesture is still this action when it lasted
+    /// half as long and went as far as the least example. Absent for a pattern written by
+    /// hand, or learnt before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub briefest_s: Option<f32>,
 }
 
 /// Human-readable compiled automaton.
@@ -191,6 +197,7 @@ impl ActionEntry {
             travel_share: None,
             hold_s: None,
             sweeps: None,
+            briefest_s: None,
         };
         let c = Regex::parse(regex)?.compile()?;
         e.max_edits = max_edits.unwrap_or_else(|| default_edits(c.min_len()));
@@ -235,6 +242,12 @@ impl ActionEntry {
     /// [`ActionEntry::sweeps`]).
     pub fn with_sweeps(mut self, sweeps: Option<u8>) -> Self {
         self.sweeps = sweeps;
+        self
+    }
+
+    /// The same entry with the briefest example's moving time (see [`ActionEntry::briefest_s`]).
+    pub fn with_briefest(mut self, briefest_s: Option<f32>) -> Self {
+        self.briefest_s = briefest_s.filter(|h| h.is_finite() && *h > 0.0);
         self
     }
 
@@ -290,6 +303,7 @@ impl ActionEntry {
                         .filter(|t| t.is_finite() && extent.is_some())
                         .map_or(0, q),
                     self.sweeps.unwrap_or(0),
+                    duration_byte(self.briefest_s),
                 ]
             }
             _ => [0; SHAPE_BYTES],

@@ -518,7 +518,8 @@ mod tests {
         )
         .with_shape(Some([0.1, 0.3, 0.8, 1.2, 0.2, 0.1]))
         .with_hold(Some(0.33))
-        .with_sweeps(Some(2));
+        .with_sweeps(Some(2))
+        .with_briefest(Some(0.21));
         kick.extent = Some([0.05, 0.34]);
         kick.travel_m = Some(0.004);
         kick.travel_share = Some(0.06);
@@ -538,7 +539,7 @@ mod tests {
         // And the device reads them from the library's blob.
         let blob = lib.blob().unwrap();
         let dev = figurine_recognizer::pattern::Library::from_bytes(&blob).unwrap();
-        assert_eq!(dev.least_sweeps(1), 2);
+        assert_eq!((dev.least_sweeps(1), dev.briefest_us(1)), (2, 210_000));
         assert!(
             (320_000..=340_000).contains(&dev.hold_us(1)),
             "{}",

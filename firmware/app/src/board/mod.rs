@@ -9,7 +9,7 @@
 
 use figurine_store::TwoSlotStore;
 
-/// Bytes of one library slot: the recognizer's largest library (12,264 B) + header, in
+/// Bytes of one library slot: the recognizer's largest library (12,296 B) + header, in
 /// whole 4 KiB pages.
 pub const LIBRARY_SLOT: u32 = 16 * 1024;
 /// Bytes of one effort-model slot (largest model 560 B + header).

@@ -14,7 +14,7 @@
 
 use crate::alignment::FULL;
 use crate::bayes::quantise;
-use crate::extent::{far_enough, noise_reach, span_extent, FIDGET_MOVED_M};
+use crate::extent::{far_enough, noise_reach, span_extent, went_as_far, FIDGET_MOVED_M};
 use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::history::HISTORY_RUNS;
@@ -122,19 +122,45 @@ impl<'lib> Recognizer<'lib> {
         }
     }
 
+    /// Whether `c`'s action's examples vouch for a match that lasted only `lasted_us`: it is
+    /// a whole gesture, from rest to rest, as each example was; the briefest of them lasted
+    /// at most twice as long (a sudden performance takes about half the time of a neutral
+    /// one); and it went as far as the least of them, in a dimension that carries the action
+    /// ([`went_as_far`]). A flicker spells a pattern in passing, inside other motion or
+    /// without covering its ground; a player who flicks the toy through a sidestep as
+    /// quickly as they taught it plays the whole of it.
+    #[cold]
+    fn examples_as_brief(&self, c: &Candidate, lasted_us: u64) -> bool {
+        let a = usize::from(c.action);
+        let briefest_us = self.library.briefest_us(a);
+        let hist = self.front.history();
+        // At rest on either side (or nothing more in the history).
+        let rest = |i: u32| hist.get(i).is_none_or(|r| r.token == STILL);
+        briefest_us > 0
+            && briefest_us <= 2 * lasted_us
+            && rest(c.start.wrapping_sub(1))
+            && rest(c.end.wrapping_add(1))
+            && self
+                .library
+                .extent(a)
+                .is_some_and(|least| went_as_far(span_extent(hist, c.start, c.end), least))
+    }
+
     /// The event `c` would be, and the runs of its motion phrase; or why there is none (its
     /// runs are gone, or it is too brief to be a gesture).
     pub(super) fn event_of(&self, c: &Candidate) -> Result<(Held, (u32, u32)), Why> {
         let hist = self.front.history();
         let start = hist.get(c.start).ok_or(Why::Lost)?.start;
         let end = hist.get(c.end).ok_or(Why::Lost)?.end;
-        if end.1.saturating_sub(start.1) < MIN_ACTION_US
+        let lasted_us = end.1.saturating_sub(start.1);
+        if lasted_us < MIN_ACTION_US
             && hist.accum(c.start, c.end).turn_sum() * TICK_S < BRIEF_TURN_RAD
+            && !self.examples_as_brief(c, lasted_us)
         {
             // A flicker of a token or two that happens to spell a short pattern: no child's
-            // gesture is this brief, unless it turned the figurine a quarter turn. (Checked
-            // first, before the phrase around the match is gathered for its effort; once per
-            // report or commit, not per sample.)
+            // gesture is this brief, unless it turned the figurine a quarter turn, or its
+            // action's own examples were this quick. (Checked first, before the phrase around
+            // the match is gathered for its effort; once per report or commit, not per sample.)
             return Err(Why::TooBrief);
         }
         // Effort is read over the whole motion phrase around the match — out to the stillness
@@ -455,6 +481,50 @@ mod tests {
         let (s, e) = (ev[0].start_us, ev[0].end_us);
         assert!(s <= 600_000 && s + half >= 600_000, "{ev:?}");
         assert!(e >= 720_000 && e <= 720_000 + 2 * half, "{ev:?}");
+    }
+
+    #[test]
+    fn a_quick_turn_its_examples_were_as_quick_as_is_one() {
+        // The twist of the test above, 57° in 0.12 s, read by a turn learnt from examples
+        // that turned at least 0.9 rad.
+        let blob = seq_library(&[(&[".Yp"], 0)]);
+        let learnt = crate::pattern::tests::with_extents(&blob, &[(0.001, 0.9)]);
+        let run_with = |briefest_us: u64| {
+            let lib = crate::pattern::tests::with_briefest(&learnt, 0, briefest_us);
+            run_noted(&Library::from_bytes(&lib).unwrap(), &quick_twist(1.0))
+        };
+        // Examples that took 0.4 s say nothing for a twist of 0.12: a flicker.
+        let (ev, notes) = run_with(400_000);
+        assert_eq!(ev, []);
+        assert!(notes.iter().any(|n| n.why == Why::TooBrief), "{notes:?}");
+        // Examples of 0.2 s, and it turned as far as the least of them: a turn.
+        let (ev, _) = run_with(200_000);
+        assert_eq!(ev.len(), 1, "{ev:?}");
+        // The same twist run straight into a stroke aside: spelt in passing, not a gesture
+        // from rest to rest as the examples were, so not a turn of its own (the phrase as a
+        // whole may still be read as its nearest action).
+        let lib = crate::pattern::tests::with_briefest(&learnt, 0, 200_000);
+        let mut twist_then_aside = quick_twist(1.0);
+        for s in twist_then_aside.iter_mut() {
+            let t = s.t_us as f32 * 1e-6;
+            s.pos[0] += 0.15 * ramp((t - 0.72) / 0.2);
+        }
+        let (ev, notes) = run_noted(&Library::from_bytes(&lib).unwrap(), &twist_then_aside);
+        assert!(ev.iter().all(|e| e.end_us > 900_000), "{ev:?}");
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.why == Why::TooBrief && n.end_us <= 750_000),
+            "{notes:?}"
+        );
+        // Not learnt (a version 10 library): the floor alone.
+        assert_eq!(run_with(0).0, []);
+        // As brief as the examples, but short of where the least of them turned: a flicker.
+        let short = crate::pattern::tests::with_extents(&blob, &[(0.001, 1.4)]);
+        let lib = crate::pattern::tests::with_briefest(&short, 0, 200_000);
+        let (ev, notes) = run_noted(&Library::from_bytes(&lib).unwrap(), &quick_twist(1.0));
+        assert_eq!(ev, []);
+        assert!(notes.iter().any(|n| n.why == Why::TooBrief), "{notes:?}");
     }
 
     #[test]
