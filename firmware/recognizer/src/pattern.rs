@@ -438,36 +438,30 @@ impl<'a> Library<'a> {
     /// The fewest sub-movements ([`crate::sweep`]) any of action `i`'s examples made (0: not
     /// learnt, a library older than version 10).
     pub fn least_sweeps(&self, i: usize) -> u8 {
-        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_SWEEPS_AT {
-            return 0;
-        }
-        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_SWEEPS_AT;
-        self.bytes.get(at).copied().unwrap_or(0)
+        self.entry_byte(i, SHAPE_SWEEPS_AT)
     }
 
     /// How long the briefest of action `i`'s examples moved, µs, from its first motion to its
     /// last (0: not learnt, a library older than version 11).
     pub fn briefest_us(&self, i: usize) -> u64 {
-        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_BRIEF_AT {
-            return 0;
-        }
-        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_BRIEF_AT;
-        self.bytes
-            .get(at)
-            .map_or(0, |&b| u64::from(b) * HOLD_UNIT_US)
+        u64::from(self.entry_byte(i, SHAPE_BRIEF_AT)) * HOLD_UNIT_US
     }
 
     /// The longest stillness inside any of action `i`'s examples, µs: how long a performance
     /// of it may hold still and go on (0 when its examples never held, or not learnt: a
     /// library older than version 7).
     pub fn hold_us(&self, i: usize) -> u64 {
-        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= SHAPE_HOLD_AT {
+        u64::from(self.entry_byte(i, SHAPE_HOLD_AT)) * HOLD_UNIT_US
+    }
+
+    /// Byte `at` of action `i`'s shape-table entry; 0 (not learnt) when the table or the
+    /// entry is absent, or the library's version ends its entries before it.
+    fn entry_byte(&self, i: usize, at: usize) -> u8 {
+        if self.shapes == 0 || i >= self.n || usize::from(self.stride) <= at {
             return 0;
         }
-        let at = usize::from(self.shapes) + usize::from(self.stride) * i + SHAPE_HOLD_AT;
-        self.bytes
-            .get(at)
-            .map_or(0, |&b| u64::from(b) * HOLD_UNIT_US)
+        let at = usize::from(self.shapes) + usize::from(self.stride) * i + at;
+        self.bytes.get(at).copied().unwrap_or(0)
     }
 
     /// Number of actions.
@@ -697,10 +691,16 @@ pub(crate) mod tests {
     /// `blob` (the current version, with its shape table) with action `i`'s fewest
     /// sub-movements set to `made`.
     pub fn with_sweeps(blob: &[u8], i: usize, made: u8) -> Vec<u8> {
+        with_entry_byte(blob, i, SHAPE_SWEEPS_AT, made)
+    }
+
+    /// `blob` (the current version, with its shape table) with byte `at` of action `i`'s
+    /// entry set to `b`.
+    fn with_entry_byte(blob: &[u8], i: usize, at: usize, b: u8) -> Vec<u8> {
         let mut out = blob.to_vec();
         let n = usize::from(out[4]);
-        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_SWEEPS_AT;
-        out[at] = made;
+        let at = out.len() - (n - i) * SHAPE_BYTES + at;
+        out[at] = b;
         out
     }
 
@@ -719,21 +719,15 @@ pub(crate) mod tests {
     /// `blob` (the current version, with its shape table) with action `i`'s briefest example
     /// set to `briefest_us` (rounded down to [`HOLD_UNIT_US`]).
     pub fn with_briefest(blob: &[u8], i: usize, briefest_us: u64) -> Vec<u8> {
-        let mut out = blob.to_vec();
-        let n = usize::from(out[4]);
-        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_BRIEF_AT;
-        out[at] = (briefest_us / HOLD_UNIT_US).min(255) as u8;
-        out
+        let code = (briefest_us / HOLD_UNIT_US).min(255) as u8;
+        with_entry_byte(blob, i, SHAPE_BRIEF_AT, code)
     }
 
     /// `blob` (the current version, with its shape table) with action `i`'s learnt hold set
     /// to `hold_us` (rounded down to [`HOLD_UNIT_US`]).
     pub fn with_hold(blob: &[u8], i: usize, hold_us: u64) -> Vec<u8> {
-        let mut out = blob.to_vec();
-        let n = usize::from(out[4]);
-        let at = out.len() - (n - i) * SHAPE_BYTES + SHAPE_HOLD_AT;
-        out[at] = (hold_us / HOLD_UNIT_US).min(255) as u8;
-        out
+        let code = (hold_us / HOLD_UNIT_US).min(255) as u8;
+        with_entry_byte(blob, i, SHAPE_HOLD_AT, code)
     }
 
     #[test]
@@ -775,6 +769,14 @@ pub(crate) mod tests {
         let last = bad.len() - 2;
         bad[last] = 7;
         assert!(Library::from_bytes(&bad).is_err());
+        // An older version's library: action 0's entry `first`, action 1's all zero.
+        let older = |version: u8, first: &[u8]| {
+            let mut old = v1.clone();
+            old[3] = version;
+            old.extend(first);
+            old.extend(core::iter::repeat_n(0, first.len()));
+            old
+        };
         // Versions 2, 3 and 4: four, six and seven bytes per entry; their patterns load,
         // their shapes (which lack the turn and the still share, the height, or a tolerance
         // per dimension) are not used.
@@ -783,10 +785,7 @@ pub(crate) mod tests {
             (3, &[0, 255, 51, 52, 9, 9]),
             (4, &[0, 255, 51, 52, 9, 9, 128]),
         ] {
-            let mut old = v1.clone();
-            old[3] = version;
-            old.extend(entry);
-            old.extend(core::iter::repeat_n(0, entry.len()));
+            let mut old = older(version, entry);
             let lib = Library::from_bytes(&old).unwrap();
             assert_eq!((lib.len(), lib.shape(0)), (2, None), "version {version}");
             assert_eq!(lib.shape_tolerance(0), [0.0; 6]);
@@ -795,10 +794,7 @@ pub(crate) mod tests {
             assert!(Library::from_bytes(&old).is_err(), "version {version}");
         }
         // Version 5: thirteen bytes per entry, the shape without the extents.
-        let mut v5 = v1.clone();
-        v5[3] = 5;
-        v5.extend([0, 255, 51, 1, 51, 255, 153, 0, 51, 0, 0, 0, 255]);
-        v5.extend([0; 13]);
+        let v5 = older(5, &[0, 255, 51, 1, 51, 255, 153, 0, 51, 0, 0, 0, 255]);
         let lib = Library::from_bytes(&v5).unwrap();
         assert!(near(lib.shape(0), want));
         assert_eq!(lib.shape_tolerance(0), [0.0, 0.2, 0.0, 0.0, 0.0, 1.0]);
@@ -839,11 +835,7 @@ pub(crate) mod tests {
             (920_000, 0, 0)
         );
         // Version 7: sixteen bytes per entry, the hold without the travel.
-        let mut v7 = v1.clone();
-        v7[3] = 7;
-        let held_entry = &held[entry..entry + SHAPE_BYTES_V7];
-        v7.extend(held_entry);
-        v7.extend([0; SHAPE_BYTES_V7]);
+        let v7 = older(7, &held[entry..entry + SHAPE_BYTES_V7]);
         let lib = Library::from_bytes(&v7).unwrap();
         assert_eq!((lib.hold_us(0), lib.hold_us(1)), (920_000, 0));
         assert!(near(lib.shape(0), want));
@@ -862,10 +854,7 @@ pub(crate) mod tests {
         ext[entry + SHAPE_TRAVEL_SHARE_AT] = 153;
         let e = lib_extent(&ext).unwrap();
         assert!((e.travel_share - 0.6).abs() < 1e-6, "{e:?}");
-        let mut v8 = v1.clone();
-        v8[3] = 8;
-        v8.extend(&ext[entry..entry + SHAPE_BYTES_V8]);
-        v8.extend([0; SHAPE_BYTES_V8]);
+        let v8 = older(8, &ext[entry..entry + SHAPE_BYTES_V8]);
         let e = lib_extent(&v8).unwrap();
         assert!(
             (e.travel_m - 0.0512).abs() < 1e-5 && e.travel_share == 0.0,
@@ -884,10 +873,7 @@ pub(crate) mod tests {
             ),
             (4, 0, 0)
         );
-        let mut v9 = v1.clone();
-        v9[3] = 9;
-        v9.extend(&ext[entry..entry + SHAPE_BYTES_V9]);
-        v9.extend([0; SHAPE_BYTES_V9]);
+        let v9 = older(9, &ext[entry..entry + SHAPE_BYTES_V9]);
         let lib = Library::from_bytes(&v9).unwrap();
         assert_eq!(lib.least_sweeps(0), 0);
         assert!(lib_extent(&v9).is_some_and(|e| (e.travel_share - 0.6).abs() < 1e-6));
@@ -896,14 +882,8 @@ pub(crate) mod tests {
         assert_eq!(Library::from_bytes(&ext).unwrap().briefest_us(0), 0);
         ext[entry + SHAPE_BRIEF_AT] = 18;
         let lib = Library::from_bytes(&ext).unwrap();
-        assert_eq!(
-            (lib.briefest_us(0), lib.briefest_us(1), lib.briefest_us(9)),
-            (180_000, 0, 0)
-        );
-        let mut v10 = v1.clone();
-        v10[3] = 10;
-        v10.extend(&ext[entry..entry + SHAPE_BYTES_V10]);
-        v10.extend([0; SHAPE_BYTES_V10]);
+        assert_eq!([0, 1, 9].map(|i| lib.briefest_us(i)), [180_000, 0, 0]);
+        let v10 = older(10, &ext[entry..entry + SHAPE_BYTES_V10]);
         let lib = Library::from_bytes(&v10).unwrap();
         assert_eq!((lib.briefest_us(0), lib.least_sweeps(0)), (0, 4));
         // The extents, both known or neither.
