@@ -6,7 +6,7 @@
 //!
 //! | [`Why`] | rule | where |
 //! |---|---|---|
-//! | [`Why::TooBrief`] | briefer than [`crate::segment::MIN_ACTION_US`], turned less than [`crate::segment::BRIEF_TURN_RAD`], and not as quick as its action's examples were (half the briefest, as far as the least): a flicker | segment |
+//! | [`Why::TooBrief`] | briefer than [`crate::segment::MIN_ACTION_US`], turned less than [`crate::segment::BRIEF_TURN_RAD`], and not a whole gesture, from rest to rest, as quick as its action's examples (half the briefest) and as far as the least of them: a flicker | segment |
 //! | [`Why::NotFarEnough`] | a new event that went less far (or, for an action whose examples travelled, ended less far away) than its action's examples allow: a fidget | [`crate::extent`] |
 //! | [`Why::OneSweep`] | a new event whose motion, from rest to rest, was one sweep, where its action's examples each made several pushes: a toy carried | [`crate::sweep`] |
 //! | [`Why::Settles`] | the settling of the event before it, which moved much more | [`crate::follow`] |
@@ -24,8 +24,8 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Why {
-    /// Dropped: briefer than the least action, not turned a quarter turn, and not as quick as
-    /// its action's examples were.
+    /// Dropped: briefer than the least action, not turned a quarter turn, and not a whole
+    /// gesture its action's examples vouch for.
     TooBrief,
     /// Dropped: a new event that did not go (or travel) as far as its action's examples.
     NotFarEnough,

@@ -393,8 +393,8 @@ pub fn why_words(n: &Note, names: &[String]) -> String {
     let action = name_of(names, n.action);
     match n.why {
         Why::TooBrief => format!(
-            "dropped: briefer than {:.2} s and turned less than {:.0}°, and than half \
-             `{action}`'s briefest example or short of the least of them (a flicker)",
+            "dropped: briefer than {:.2} s, turned less than {:.0}°, and not a whole gesture \
+             as quick as `{action}`'s examples and as far as the least of them (a flicker)",
             MIN_ACTION_US as f64 * 1e-6,
             f64::from(BRIEF_TURN_RAD).to_degrees()
         ),
