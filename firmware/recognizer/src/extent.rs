@@ -197,10 +197,7 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     let ends_away = moved < CARRY_SHARE * turned
         || least.travel_share < AWAY_SHARE
         || went.travel_m + fidget_moved >= AWAY_SHARE * went.moved_m;
-    went.travel_m >= need_travel
-        && ends_away
-        && ((moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
-            || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned))
+    went.travel_m >= need_travel && ends_away && reaches(went, least, need_moved, need_turned)
 }
 
 /// Whether a span that `went` so far reached the whole of the `least` extent an action's
@@ -208,10 +205,17 @@ pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
 /// the action (at least [`CARRY_SHARE`] of the other's): what a match briefer than any
 /// gesture must show to be one ([`crate::segment::MIN_ACTION_US`]).
 pub fn went_as_far(went: Extent, least: Extent) -> bool {
+    reaches(went, least, least.moved_m, least.turned_rad)
+}
+
+/// Whether `went` reached `need_moved` (m) or `need_turned` (rad) in a dimension that carries
+/// an action whose examples went `least` at the least: one whose least extent, rotation
+/// weighed by [`ARM_M`], is at least [`CARRY_SHARE`] of the other's.
+fn reaches(went: Extent, least: Extent, need_moved: f32, need_turned: f32) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
-    (moved >= CARRY_SHARE * turned && went.moved_m >= moved)
-        || (turned >= CARRY_SHARE * moved && went.turned_rad >= least.turned_rad)
+    (moved >= CARRY_SHARE * turned && went.moved_m >= need_moved)
+        || (turned >= CARRY_SHARE * moved && went.turned_rad >= need_turned)
 }
 
 /// A learnt extent `x` (in the code's `unit`) as the library's byte: 1 + 16·log2(x / unit),
