@@ -12,13 +12,15 @@
 //!   precision, recall and F1, and why the unmatched events did not match ([`ExtraKind`]);
 //! - handling that plays no action ([`Handling`]: the toy carried elsewhere, lifted and set
 //!   down; `--isolated` logs of each kind): the share on which nothing is reported;
-//! - a toy held in a hand that talks ([`Handling::Talk`], `--isolated` logs): events per hour;
+//! - a toy held in a hand that talks ([`Handling::Talk`], `--isolated` logs): events per hour,
+//!   and the actions they were read as;
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile).
 //!
 //! The benchmarks (`figurine eval rest | sweep | real | repeat`) are dispatched by
 //! [`super::eval_cli`], each in its own module; they use what is here.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -214,8 +216,9 @@ pub struct EffortCounts {
 }
 
 /// Events over logs of a toy held in a hand that talks, and how long the talking lasted: a
-/// rate per hour, as `eval rest` and `eval real` give theirs.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+/// rate per hour, as `eval rest` and `eval real` give theirs; and which actions the events
+/// were, since each action's rule is what a fix for them would change.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct TalkCounts {
     /// Events reported (every one false).
     pub events: usize,
@@ -223,14 +226,41 @@ pub struct TalkCounts {
     pub logs: usize,
     /// Seconds of talking (the handled spans), summed.
     pub seconds: f64,
+    /// The events by the action they were reported as.
+    pub by_action: BTreeMap<String, usize>,
 }
 
 impl TalkCounts {
+    /// The counts of one log: its events' action names and how long the talking lasted (s).
+    pub fn of_log<'a>(actions: impl IntoIterator<Item = &'a str>, seconds: f64) -> Self {
+        let mut c = TalkCounts {
+            logs: 1,
+            seconds,
+            ..TalkCounts::default()
+        };
+        for a in actions {
+            c.events += 1;
+            *c.by_action.entry(a.to_string()).or_default() += 1;
+        }
+        c
+    }
+
     /// Adds `o`'s counts.
-    pub fn add(&mut self, o: TalkCounts) {
+    pub fn add(&mut self, o: &TalkCounts) {
         self.events += o.events;
         self.logs += o.logs;
         self.seconds += o.seconds;
+        for (a, n) in &o.by_action {
+            *self.by_action.entry(a.clone()).or_default() += n;
+        }
+    }
+
+    /// `read as A n, B m, …`, the most frequent first (ties by name); `None` without events.
+    pub fn actions_words(&self) -> Option<String> {
+        let mut all: Vec<(&String, &usize)> = self.by_action.iter().collect();
+        all.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+        let shown: Vec<String> = all.iter().map(|(a, n)| format!("{a} {n}")).collect();
+        (!shown.is_empty()).then(|| format!("read as {}", shown.join(", ")))
     }
 
     /// Events per hour of talking (0 when nothing was played).
@@ -395,11 +425,10 @@ pub fn evaluate(
         let seed = synth::sequence::item_seed(args.seed ^ TALK_SEED, k as u64);
         let d = synth::handled(seed, knobs, Handling::Talk);
         let evs = run_doodle(&d, &names, &blob, effort)?;
-        f.talk.add(TalkCounts {
-            events: evs.len(),
-            logs: 1,
-            seconds: d.handled.iter().map(|h| h.end - h.start).sum(),
-        });
+        f.talk.add(&TalkCounts::of_log(
+            evs.iter().map(|e| e.action.as_str()),
+            d.handled.iter().map(|h| h.end - h.start).sum(),
+        ));
         if args.verbose && !evs.is_empty() {
             let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
             eprintln!(
@@ -593,9 +622,12 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         kinds.join(", ")
     );
     println!(
-        "Held in a hand that talks, playing no action ({} logs): {}",
+        "Held in a hand that talks, playing no action ({} logs): {}{}",
         f.talk.logs,
-        f.talk.words()
+        f.talk.words(),
+        f.talk
+            .actions_words()
+            .map_or(String::new(), |w| format!(" ({w})"))
     );
     let (med, p90) = quantiles(&f.latencies);
     println!(

@@ -95,7 +95,7 @@ impl Tally {
             self.silent += n - loud.min(n);
             self.handling += n;
         }
-        self.talk.add(f.talk);
+        self.talk.add(&f.talk);
         for (played, read, n) in &f.confusions {
             *self
                 .misreads
@@ -243,6 +243,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     if let Some(line) = tally.misreads_line() {
         println!("{line}");
     }
+    if let Some(words) = tally.talk.actions_words() {
+        println!("a hand that talks, over the pairs: {words}");
+    }
     Ok(())
 }
 
@@ -290,10 +293,14 @@ mod tests {
                 state: read - 3,
             },
             handling: vec![("lift".into(), 7, loud, 20)],
-            talk: TalkCounts {
-                events: 3,
-                logs: 20,
-                seconds: 90.0,
+            talk: {
+                let mut talk = TalkCounts {
+                    logs: 19,
+                    seconds: 60.0,
+                    ..TalkCounts::default()
+                };
+                talk.add(&TalkCounts::of_log(["turn", "sidestep", "turn"], 30.0));
+                talk
             },
             confusions: vec![
                 ("walk".into(), "run".into(), 10 - ok),
@@ -329,5 +336,10 @@ mod tests {
             )
         );
         assert_eq!(Tally::default().misreads_line(), None);
+        assert_eq!(
+            t.talk.actions_words().as_deref(),
+            Some("read as turn 4, sidestep 2")
+        );
+        assert_eq!(Tally::default().talk.actions_words(), None);
     }
 }
