@@ -425,12 +425,12 @@ pub fn evaluate(
         let seed = synth::sequence::item_seed(args.seed ^ TALK_SEED, k as u64);
         let d = synth::handled(seed, knobs, Handling::Talk);
         let evs = run_doodle(&d, &names, &blob, effort)?;
+        let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
         f.talk.add(&TalkCounts::of_log(
-            evs.iter().map(|e| e.action.as_str()),
+            got.iter().copied(),
             d.handled.iter().map(|h| h.end - h.start).sum(),
         ));
-        if args.verbose && !evs.is_empty() {
-            let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
+        if args.verbose && !got.is_empty() {
             eprintln!(
                 "talk -> {} (figurine synth handling --kind talk --seed {seed}{})",
                 got.join(" "),

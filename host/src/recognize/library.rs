@@ -247,7 +247,7 @@ impl ActionEntry {
 
     /// The same entry with the briefest example's moving time (see [`ActionEntry::briefest_s`]).
     pub fn with_briefest(mut self, briefest_s: Option<f32>) -> Self {
-        self.briefest_s = briefest_s.filter(|h| h.is_finite() && *h > 0.0);
+        self.briefest_s = briefest_s.filter(|s| s.is_finite() && *s > 0.0);
         self
     }
 
