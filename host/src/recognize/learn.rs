@@ -66,9 +66,11 @@ pub struct LearnArgs {
 }
 
 /// One example log, read once through the device front end: its gesture's runs (STILL
-/// included) and the span (seconds, log clock) from its first to its last motion.
+/// included), the still run before them, and the span (seconds, log clock) from its first to
+/// its last motion.
 struct Example {
     runs: Vec<Run>,
+    rest: Option<Run>,
     span: Option<(f64, f64)>,
 }
 
@@ -82,8 +84,14 @@ impl Example {
             .first()
             .zip(g.last())
             .map(|(a, b)| (clock.time_of(a.start.0), clock.time_of(b.end.0)));
+        let first = runs.iter().position(|r| r.token != STILL);
+        let rest = first
+            .and_then(|i| i.checked_sub(1))
+            .and_then(|i| runs.get(i))
+            .copied();
         Example {
             runs: g.to_vec(),
+            rest,
             span,
         }
     }
@@ -121,9 +129,14 @@ fn shape_of_runs(g: &[Run]) -> Option<Shape> {
     Some(sums.shape())
 }
 
-/// How far a gesture's runs went from where it began ([`figurine_recognizer::extent`]).
-fn extent_of_runs(g: &[Run]) -> Extent {
+/// How far a gesture's runs went from where it began, its rotation from where it rested
+/// before (`rest`, the still run before them: [`ExtentSums::add_rest`]), as the device
+/// measures a performance ([`figurine_recognizer::extent`]).
+fn extent_of_runs(rest: Option<&Run>, g: &[Run]) -> Extent {
     let mut sums = ExtentSums::new();
+    if let Some(r) = rest {
+        sums.add_rest(&r.acc);
+    }
     for r in g {
         sums.add(&r.acc);
     }
@@ -207,12 +220,14 @@ pub fn fewest_sweeps<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Optio
 /// its own reach that one travelled), each as the examples' [`lower_quartile`] (of three: the
 /// least): how far the least of an action's examples went, what the device holds a
 /// performance to ([`figurine_recognizer::extent::far_enough`]). None without a gesture.
-pub fn least_extent<'a>(gestures: impl IntoIterator<Item = &'a [Run]>) -> Option<Extent> {
+pub fn least_extent<'a>(
+    gestures: impl IntoIterator<Item = (Option<&'a Run>, &'a [Run])>,
+) -> Option<Extent> {
     let each: Vec<Extent> = gestures
         .into_iter()
-        .filter(|g| !g.is_empty())
-        .map(|g| {
-            let e = extent_of_runs(g);
+        .filter(|(_, g)| !g.is_empty())
+        .map(|(rest, g)| {
+            let e = extent_of_runs(rest, g);
             Extent {
                 travel_share: if e.moved_m > 0.0 {
                     (e.travel_m / e.moved_m).clamp(0.0, 1.0)
@@ -318,7 +333,9 @@ pub fn learn_action(
     )?
     .with_shape(mean_shape(&shapes))
     .with_shape_tolerance(shape_tolerance(&shapes))
-    .with_extent(least_extent(read.iter().map(|e| &e.runs[..])))
+    .with_extent(least_extent(
+        read.iter().map(|e| (e.rest.as_ref(), &e.runs[..])),
+    ))
     .with_hold(longest_hold(read.iter().map(|e| &e.runs[..])))
     .with_sweeps(fewest_sweeps(read.iter().map(|e| &e.runs[..])))
     .with_briefest(briefest(read.iter().map(|e| &e.runs[..])));
@@ -632,7 +649,11 @@ mod tests {
             .map(|d| d.log)
             .collect();
         let gestures: Vec<Vec<Run>> = logs.iter().map(log_gesture).collect();
-        let moved = |g: &[Vec<Run>]| least_extent(g.iter().map(|g| &g[..])).unwrap().moved_m;
+        let moved = |g: &[Vec<Run>]| {
+            least_extent(g.iter().map(|g| (None, &g[..])))
+                .unwrap()
+                .moved_m
+        };
         let mut each: Vec<f32> = gestures
             .iter()
             .map(|g| moved(std::slice::from_ref(g)))

@@ -14,7 +14,9 @@
 
 use crate::alignment::FULL;
 use crate::bayes::quantise;
-use crate::extent::{far_enough, noise_reach, span_extent, went_as_far, FIDGET_MOVED_M};
+use crate::extent::{
+    far_enough, noise_reach, rested_extent, span_extent, went_as_far, FIDGET_MOVED_M,
+};
 use crate::features::segment_features;
 use crate::follow::{follow, Follow, Held};
 use crate::history::HISTORY_RUNS;
@@ -63,10 +65,14 @@ impl<'lib> Recognizer<'lib> {
         // went before. A fidget seems to go as far as the tracker's noise takes it besides.
         let hist = self.front.history();
         let noise = noise_reach(self.front.noise_rms());
+        // The stillness the phrase began from, unless an earlier commit consumed it.
+        let rested = from.wrapping_sub(1);
+        let rest = hist.get(rested).filter(|r| {
+            r.token == STILL && rested.wrapping_sub(self.floor) <= from.wrapping_sub(self.floor)
+        });
+        let went = rested_extent(hist, rest, from, to);
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
-            Some(least) if !far_enough(span_extent(hist, from, to), least, noise) => {
-                Err(Why::NotFarEnough)
-            }
+            Some(least) if !far_enough(went, least, noise) => Err(Why::NotFarEnough),
             Some(least) => {
                 let made = self.library.least_sweeps(usize::from(ev.action));
                 if carried(least, made, c.cost, hist, from, to) {
