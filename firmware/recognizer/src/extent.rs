@@ -205,12 +205,12 @@ pub fn noise_reach(rms: (f32, f32)) -> Extent {
 
 /// Whether motion that went `went` went far enough to be an action whose least example went
 /// `least`: at least [`ACCEPT_SHARE`] of a displacement (or [`ENOUGH_MOVED_M`] if less), or
-/// [`TURN_ACCEPT_SHARE`] of a rotation, in a dimension that carries the action, and as far across the floor when moving
-/// carries it and its examples travelled (at least [`CARRY_SHARE`] of how far they moved,
-/// and farther than a fidget), and ends [`AWAY_SHARE`] of its own reach away when each of
-/// its examples did ([`Extent::travel_share`]). A fidget seen through a tracker's `noise`
-/// ([`noise_reach`]) reaches as far as the two together (in quadrature: they are
-/// independent).
+/// [`TURN_ACCEPT_SHARE`] of a rotation, in a dimension that carries the action, and as far
+/// across the floor when moving carries it and its examples travelled (at least
+/// [`CARRY_SHARE`] of how far they moved, and farther than a fidget), and ends
+/// [`AWAY_SHARE`] of its own reach away when each of its examples did
+/// ([`Extent::travel_share`]). A fidget seen through a tracker's `noise` ([`noise_reach`])
+/// reaches as far as the two together (in quadrature: they are independent).
 pub fn far_enough(went: Extent, least: Extent, noise: Extent) -> bool {
     let moved = least.moved_m;
     let turned = ARM_M * least.turned_rad;
