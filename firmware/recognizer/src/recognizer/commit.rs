@@ -70,9 +70,10 @@ impl<'lib> Recognizer<'lib> {
         let rest = hist.get(rested).filter(|r| {
             r.token == STILL && rested.wrapping_sub(self.floor) <= from.wrapping_sub(self.floor)
         });
-        let went = rested_extent(hist, rest, from, to);
         let new = |ev: Held| match self.library.extent(usize::from(ev.action)) {
-            Some(least) if !far_enough(went, least, noise) => Err(Why::NotFarEnough),
+            Some(least) if !far_enough(rested_extent(hist, rest, from, to), least, noise) => {
+                Err(Why::NotFarEnough)
+            }
             Some(least) => {
                 let made = self.library.least_sweeps(usize::from(ev.action));
                 if carried(least, made, c.cost, hist, from, to) {
