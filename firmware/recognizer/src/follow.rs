@@ -2,8 +2,10 @@
 //! its settling, or a new action.
 //!
 //! The last event stays *held* until [`CONTINUE_US`] of stillness have passed after it (or its
-//! runs leave the history). A match committed while it is held, with nothing but stillness
-//! and at most [`CONTINUE_GAP_RUNS`] moving runs between them, is one of:
+//! runs leave the history) — for a cyclic action, of rest counted from where its strokes
+//! settled, so that a noisy tracker's slow stride ends are no pause. A match committed while
+//! it is held, with nothing but stillness and at most [`CONTINUE_GAP_RUNS`] moving runs
+//! between them, is one of:
 //!
 //! - **its next piece**: the same action, and the runs from the held event's start to the
 //!   match's end are together one whole match of it, costing no more than the two matches
@@ -66,6 +68,9 @@ pub(crate) struct Held {
     pub distance: u8,
     /// Weighted cost of its match, half-edits.
     pub cost: u8,
+    /// Whether its action is cyclic: its pauses count from where its motion settled
+    /// ([`crate::history::Run::rested_us`]).
+    pub cyclic: bool,
     /// Feature sums over its motion phrase.
     pub acc: Accum,
 }
@@ -258,6 +263,7 @@ mod tests {
             end_run: to,
             distance: cost.div_ceil(FULL),
             cost,
+            cyclic: false,
             acc: hist.accum(from, to),
         }
     }

@@ -120,6 +120,13 @@ impl Run {
     pub fn set_off(&self) -> Option<(u32, u64)> {
         self.last_quiet.at(self.start, self.end)
     }
+
+    /// How long the figurine had rested in this run by `until` (µs of the input clock),
+    /// counted from its first quiet tick: 0 before the motion ahead of it settled. A stroke's
+    /// slow tail, under a noisy tracker's floor, makes a STILL run but is no rest.
+    pub fn rested_us(&self, until: u64) -> u64 {
+        self.settled().map_or(0, |s| until.saturating_sub(s.1))
+    }
 }
 
 /// Ring of recent runs.
@@ -307,8 +314,12 @@ mod tests {
         h.open(STILL, (1_000, 5_000_000), Accum::new());
         let r = h.newest_mut().unwrap();
         assert_eq!((r.settled(), r.set_off()), (None, None));
+        // Not yet settled: no rest at all, however long the run.
+        assert_eq!(r.rested_us(5_400_000), 0);
         r.end = (1_010, 5_100_000);
         r.mark_quiet((1_003, 5_030_000));
+        // Rested from its first quiet tick on, not from its start.
+        assert_eq!(r.rested_us(5_100_000), 70_000);
         r.mark_quiet((1_009, 5_090_000));
         assert_eq!(r.settled(), Some((1_003, 5_030_000)));
         assert_eq!(r.set_off(), Some((1_009, 5_090_000)));

@@ -220,6 +220,8 @@ impl<'lib> Recognizer<'lib> {
         if let Some(r) = newest.and_then(|i| hist.get(i)) {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
+                // A cyclic event's pause counts from where its motion settled (`follow`).
+                let rested = r.rested_us(self.front.last_tick_us());
                 // The first sample of the pause that may commit: nothing moves during a pause,
                 // so what is checked then holds for all of it.
                 let mut first = false;
@@ -305,7 +307,12 @@ impl<'lib> Recognizer<'lib> {
                 let keep = self.held.map_or(CONTINUE_US, |h| {
                     CONTINUE_US.max(self.library.hold_us(usize::from(h.action)))
                 });
-                if still >= keep {
+                let paused = if self.held.is_some_and(|h| h.cyclic) {
+                    rested
+                } else {
+                    still
+                };
+                if paused >= keep {
                     self.held = None;
                 }
             }

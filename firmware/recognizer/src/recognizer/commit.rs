@@ -88,12 +88,22 @@ impl<'lib> Recognizer<'lib> {
             return new(ev);
         };
         // Past the usual pause, only the rest of a hold its action's examples made (a crouch
-        // held low, then risen from) continues it.
+        // held low, then risen from) continues it. A cyclic action's next cycle rests only
+        // where its strokes had settled: their slow tails under a noisy tracker's floor are
+        // no pause.
         let gap = c.start.wrapping_sub(h.end_run);
+        let next_cycle = h.cyclic && h.action == c.action;
         let late = gap <= HISTORY_RUNS as u32
             && (1..gap)
                 .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
-                .any(|r| r.token == STILL && r.end.1.saturating_sub(r.start.1) >= CONTINUE_US);
+                .any(|r| {
+                    let rested = if next_cycle {
+                        r.rested_us(r.set_off().map_or(r.start.1, |o| o.1))
+                    } else {
+                        r.end.1.saturating_sub(r.start.1)
+                    };
+                    r.token == STILL && rested >= CONTINUE_US
+                });
         match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
             Follow::Settles => return Err(Why::Settles),
@@ -217,6 +227,7 @@ impl<'lib> Recognizer<'lib> {
             end_run: c.end,
             distance: c.distance(),
             cost: c.cost,
+            cyclic: c.cyclic,
             acc,
         };
         Ok((ev, (from, to)))
