@@ -303,17 +303,13 @@ impl<'lib> Recognizer<'lib> {
                         self.commit(c, out);
                     }
                 }
-                // As long as its action's examples held still inside, and no shorter.
-                let keep = self.held.map_or(CONTINUE_US, |h| {
-                    CONTINUE_US.max(self.library.hold_us(usize::from(h.action)))
-                });
-                let paused = if self.held.is_some_and(|h| h.cyclic) {
-                    rested
-                } else {
-                    still
-                };
-                if paused >= keep {
-                    self.held = None;
+                // As long as its action's examples held still inside, and no shorter; a cyclic
+                // event, for its next cycle, from where its strokes settled.
+                if let Some(h) = self.held {
+                    let paused = if h.cyclic { rested } else { still };
+                    if paused >= self.keep_held(&h) {
+                        self.held = None;
+                    }
                 }
             }
         }
@@ -361,6 +357,12 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         self.held = None;
+    }
+
+    /// How long event `h` stays held after it, µs of rest: [`CONTINUE_US`], or as long as its
+    /// action's examples held still inside if longer.
+    fn keep_held(&self, h: &Held) -> u64 {
+        CONTINUE_US.max(self.library.hold_us(usize::from(h.action)))
     }
 
     /// [`nearest_action`] for the phrase ending at run `last`, from where a phrase may begin.

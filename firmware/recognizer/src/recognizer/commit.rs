@@ -88,22 +88,26 @@ impl<'lib> Recognizer<'lib> {
             return new(ev);
         };
         // Past the usual pause, only the rest of a hold its action's examples made (a crouch
-        // held low, then risen from) continues it. A cyclic action's next cycle rests only
-        // where its strokes had settled: their slow tails under a noisy tracker's floor are
-        // no pause.
+        // held low, then risen from) continues it. A cyclic event's next cycle rests only
+        // where its strokes had settled, and the event stays held for it that long: their slow
+        // tails under a noisy tracker's floor are no pause. For anything else the pause counts
+        // from the still run's start, and past the hold the event is no longer held.
         let gap = c.start.wrapping_sub(h.end_run);
         let next_cycle = h.cyclic && h.action == c.action;
-        let late = gap <= HISTORY_RUNS as u32
-            && (1..gap)
+        let (mut still, mut rested) = (0, 0);
+        if gap <= HISTORY_RUNS as u32 {
+            for r in (1..gap)
                 .filter_map(|k| hist.get(h.end_run.wrapping_add(k)))
-                .any(|r| {
-                    let rested = if next_cycle {
-                        r.rested_us(r.set_off().map_or(r.start.1, |o| o.1))
-                    } else {
-                        r.end.1.saturating_sub(r.start.1)
-                    };
-                    r.token == STILL && rested >= CONTINUE_US
-                });
+                .filter(|r| r.token == STILL)
+            {
+                still = still.max(r.end.1.saturating_sub(r.start.1));
+                rested = rested.max(r.rested_us(r.set_off().map_or(r.start.1, |o| o.1)));
+            }
+        }
+        if !next_cycle && still >= self.keep_held(&h) {
+            return new(ev);
+        }
+        let late = if next_cycle { rested } else { still } >= CONTINUE_US;
         match follow(&self.library, hist, &h, c, late) {
             Follow::New => return new(ev),
             Follow::Settles => return Err(Why::Settles),
@@ -366,6 +370,28 @@ mod tests {
     use crate::pattern::Library;
     use crate::token::Token;
     use std::vec::Vec;
+
+    #[test]
+    fn a_cycles_slow_tail_is_no_pause() {
+        let blob = hop_library(true);
+        let lib = Library::from_bytes(&blob).unwrap();
+        // After each hop 0.3 s of creeping on under the speed floor, then 0.3 s at rest: a
+        // still run of 0.6 s, longer than ends the action (`CONTINUE_US`), of which the
+        // figurine rested 0.3 s. The next hop continues the walk.
+        let ev = run(&lib, &creeping_hops(3, 0.3, 0.3));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, true, true],
+            "{ev:?}"
+        );
+        // Resting 0.6 s it ends: the next hop is a new event.
+        let ev = run(&lib, &creeping_hops(2, 0.3, 0.6));
+        assert_eq!(
+            ev.iter().map(|e| e.revises).collect::<Vec<_>>(),
+            [false, false],
+            "{ev:?}"
+        );
+    }
 
     #[test]
     fn the_next_cycle_after_a_short_pause_continues_the_event() {
