@@ -2,8 +2,9 @@
 //! its settling, or a new action.
 //!
 //! The last event stays *held* until [`CONTINUE_US`] of stillness have passed after it (or its
-//! runs leave the history) — for a cyclic action, of rest counted from where its strokes
-//! settled, so that a noisy tracker's slow stride ends are no pause. A match committed while
+//! runs leave the history) — for a cyclic action's own next cycle, of rest counted from
+//! where its strokes settled, so that a noisy tracker's slow stride ends are no pause
+//! (the recognizer's commit). A match committed while
 //! it is held, with nothing but stillness and at most [`CONTINUE_GAP_RUNS`] moving runs
 //! between them, is one of:
 //!

@@ -39,9 +39,10 @@ pub const PAUSE_US: u64 = 120_000;
 pub const CYCLIC_PAUSE_US: u64 = 400_000;
 /// Stillness after an event up to which a match may still continue it (a cyclic action's
 /// next cycle, a one-shot action's second piece or rest) or be its settling
-/// ([`crate::follow`]), µs. After a cyclic event it counts from where the strokes settled
-/// ([`crate::history::Run::rested_us`]): under a noisy tracker their slow tails fall below the
-/// floor, and lengthen the still run between two strides without being a pause.
+/// ([`crate::follow`]), µs. For a cyclic event's own next cycle it counts from where the
+/// strokes settled ([`crate::history::Run::rested_us`]): under a noisy tracker their slow
+/// tails fall below the floor, and lengthen the still run between two strides without being
+/// a pause.
 pub const CONTINUE_US: u64 = 500_000;
 /// Moving runs that may lie between an event and a match that continues it: strokes the two
 /// matches left out at their edges (a hop's take-off before its `uf`).

@@ -64,35 +64,10 @@ pub(crate) fn run_noted(lib: &Library<'_>, samples: &[Sample]) -> (Vec<ActionEve
 
 /// `hops` hops forward (as [`hops`]), each pair of hops separated by `pause_s` of stillness.
 pub(crate) fn paused_hops(hops: usize, pause_s: f32) -> Vec<Sample> {
-    let rate = 120.0f32;
-    let (still, hop) = (0.6f32, 0.5f32);
-    let period = hop + pause_s;
-    let total = 2.0 * still + hops as f32 * period;
-    let n = (total * rate) as u32;
-    (0..n)
-        .map(|i| {
-            let t = i as f32 / rate;
-            let (mut y, mut z) = (0.0f32, 0.0f32);
-            if t > still {
-                let k = libm::floorf((t - still) / period);
-                let within = ((t - still) - k * period) / hop;
-                let done = k.min(hops as f32) + within.min(1.0);
-                z = 0.2 * done.min(hops as f32);
-                if (k as usize) < hops && within < 1.0 {
-                    y = 0.1 * libm::sinf(core::f32::consts::PI * within);
-                }
-            }
-            Sample {
-                seq: i,
-                t_us: (t * 1e6) as u64,
-                pos: [0.3, 1.0 + y, z],
-                quat: [1.0, 0.0, 0.0, 0.0],
-            }
-        })
-        .collect()
+    creeping_hops(hops, 0.0, pause_s)
 }
 
-/// [`paused_hops`] whose every hop but the last ends in a creep: `creep_s` of drifting on
+/// `hops` hops forward (as [`hops`]), each but the last ending in a creep: `creep_s` of drifting on
 /// at 2 cm/s (under the speed floor, so no token, but not at rest), then `pause_s` still.
 pub(crate) fn creeping_hops(hops: usize, creep_s: f32, pause_s: f32) -> Vec<Sample> {
     let rate = 120.0f32;
@@ -107,8 +82,7 @@ pub(crate) fn creeping_hops(hops: usize, creep_s: f32, pause_s: f32) -> Vec<Samp
             if t > still {
                 let k = libm::floorf((t - still) / period).min(hops as f32 - 1.0);
                 let within = (t - still) - k * period;
-                let crept = |k: f32| k * creep_m_s * creep_s;
-                z = 0.2 * k + crept(k) + 0.2 * (within / hop).min(1.0);
+                z = 0.2 * (k + (within / hop).min(1.0)) + k * creep_m_s * creep_s;
                 if within < hop {
                     y = 0.1 * libm::sinf(core::f32::consts::PI * within / hop);
                 } else if (k as usize) + 1 < hops {
