@@ -67,8 +67,9 @@ pub(crate) fn paused_hops(hops: usize, pause_s: f32) -> Vec<Sample> {
     creeping_hops(hops, 0.0, pause_s)
 }
 
-/// `hops` hops forward (as [`hops`]), each but the last ending in a creep: `creep_s` of drifting on
-/// at 2 cm/s (under the speed floor, so no token, but not at rest), then `pause_s` still.
+/// `hops` hops forward (as [`hops`]), each but the last ending in a creep: `creep_s` of
+/// drifting on at 2 cm/s (under the speed floor, so no token, but not at rest), then `pause_s`
+/// still.
 pub(crate) fn creeping_hops(hops: usize, creep_s: f32, pause_s: f32) -> Vec<Sample> {
     let rate = 120.0f32;
     let (still, hop, creep_m_s) = (0.6f32, 0.5f32, 0.02f32);
