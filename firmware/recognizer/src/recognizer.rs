@@ -220,8 +220,13 @@ impl<'lib> Recognizer<'lib> {
         if let Some(r) = newest.and_then(|i| hist.get(i)) {
             if r.token == STILL {
                 let still = self.front.last_tick_us().saturating_sub(r.start.1);
-                // A cyclic event's pause counts from where its motion settled (`follow`).
-                let rested = r.rested_us(self.front.last_tick_us());
+                // A cyclic event's pause counts from where its motion settled (`follow`); read
+                // only while one is held (an interpolation, on every still sample otherwise).
+                let rested = if self.held.is_some_and(|h| h.cyclic) {
+                    r.rested_us(self.front.last_tick_us())
+                } else {
+                    0
+                };
                 // The first sample of the pause that may commit: nothing moves during a pause,
                 // so what is checked then holds for all of it.
                 let mut first = false;
