@@ -263,6 +263,7 @@ impl<'lib> Recognizer<'lib> {
                             )
                         })
                         .unwrap_or(c);
+                    let c = self.first_of_two(&c).unwrap_or(c);
                     // What moved after it while it was held (a turn begun while a run's match
                     // waited for its next stride; a crouch right after a wave's last stroke) is
                     // read afresh, as after a commit at a token.
@@ -341,8 +342,16 @@ impl<'lib> Recognizer<'lib> {
     }
 
     fn flush_to(&mut self, out: &mut impl Sink) {
-        if let Some(c) = self.decider.pending() {
-            self.commit(c, out);
+        // What followed a committed match is read on, as after any commit: the stream's end
+        // is a pause long enough for everything pending.
+        for _ in 0..HISTORY_RUNS {
+            let Some(c) = self.decider.pending() else {
+                break;
+            };
+            let c = self.first_of_two(&c).unwrap_or(c);
+            if self.commit(c, out) {
+                self.feed_from(self.floor, out);
+            }
         }
         let hist = self.front.history();
         if let Some(newest) = hist.newest() {
@@ -414,6 +423,7 @@ impl<'lib> Recognizer<'lib> {
             match self.decider.offer(best, self.floor) {
                 Decision::Wait => i = i.wrapping_add(1),
                 Decision::Commit(c) => {
+                    let c = self.first_of_two(&c).unwrap_or(c);
                     if self.commit(c, out) {
                         i = self.floor;
                     } else {

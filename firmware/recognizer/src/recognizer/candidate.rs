@@ -6,7 +6,7 @@
 //! action's match that began inside it is still under way ([`Recognizer::longer_in_progress`]):
 //! a punch held at full reach after its forward stroke is not a run's stride.
 
-use crate::alignment::{prefix_cost, FULL};
+use crate::alignment::{prefix_cost, weighted_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, Matches};
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
@@ -98,6 +98,75 @@ impl<'lib> Recognizer<'lib> {
             }
         }
         best
+    }
+
+    /// The first of two performances of one one-shot action that match `c` reads as one: `c`
+    /// up to a stillness inside it, when the runs on either side are each a whole match of
+    /// the action and cost less apart than together — the rule [`crate::follow`] applies to
+    /// an event and the match after it, applied inside one match (the cheapest such cut, the
+    /// earliest among equals). A punch waiting out a kick that may begin with it reads the
+    /// next punch's wind-up into its retraction (`b f b b`, `b+` reads on), then the whole next
+    /// punch within its edits; a run's strides after a breath cost nothing more as one run.
+    /// None when there is no such cut, when `c` is exact, or cyclic (its cycles are one bout).
+    pub(super) fn first_of_two(&self, c: &Candidate) -> Option<Candidate> {
+        // An exact match costs no less apart; a cyclic action's cycles are one bout.
+        if c.cyclic || c.cost == 0 {
+            return None;
+        }
+        let a = usize::from(c.action);
+        let p = self.library.pattern(a)?;
+        let hist = self.front.history();
+        // The moving tokens of `c`, and where pauses cut them: (tokens before, last run).
+        let mut tok = [STILL; HISTORY_RUNS];
+        let mut n = 0usize;
+        // Still runs lie between moving ones: at most half the history.
+        let mut cuts = [(0usize, 0u32); HISTORY_RUNS / 2];
+        let mut n_cuts = 0usize;
+        let (mut i, mut last_moving) = (c.start, c.start);
+        for _ in 0..HISTORY_RUNS {
+            let r = hist.get(i)?;
+            if r.token != STILL {
+                *tok.get_mut(n)? = r.token;
+                n += 1;
+                last_moving = i;
+            } else if n > 0 {
+                if let Some(cut) = cuts.get_mut(n_cuts) {
+                    *cut = (n, last_moving);
+                    n_cuts += 1;
+                }
+            }
+            if i == c.end {
+                break;
+            }
+            i = i.wrapping_add(1);
+        }
+        let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
+        let whole = |t: &[Token]| {
+            weighted_cost(&p, t, bound).filter(|&v| edits_fit(v, t.len().max(p.min_len())))
+        };
+        let tokens = tok.get(..n)?;
+        // The cheapest split, the earliest among equals.
+        let (k, end, x, _) = cuts
+            .get(..n_cuts)?
+            .iter()
+            .filter(|&&(k, _)| k < n)
+            .filter_map(|&(k, end)| {
+                let (before, after) = tokens.split_at(k);
+                let (x, y) = (whole(before)?, whole(after)?);
+                Some((k, end, x, u16::from(x) + u16::from(y)))
+            })
+            .filter(|&(.., apart)| apart < u16::from(c.cost))
+            .min_by_key(|&(k, .., apart)| (apart, k))?;
+        Some(Candidate {
+            end,
+            cost: x,
+            len: k.min(usize::from(u16::MAX)) as u16,
+            shape: shape_cost(
+                shape_of(&self.library, a, hist, c.start, end).unwrap_or(0),
+                k,
+            ),
+            ..*c
+        })
     }
 
     /// Whether another action's match began with `p` (its own first part skipped) and is still
@@ -387,5 +456,61 @@ mod tests {
         );
         let lib = Library::from_bytes(&held).unwrap();
         assert_eq!(under_way(&lib, &pending(0), &[d], false, 0), Some(900_000));
+    }
+
+    #[test]
+    fn one_match_across_a_stillness_is_two_performances_when_they_cost_less_apart() {
+        // `b+ f+ b+`, a punch, played twice with a breath between (`b f b _ b f b`): one
+        // match over all six strokes needs two edits; apart, each punch is exact.
+        let blob = seq_library(&[(&["b", "f", "b"], 2)]);
+        let lib = Library::from_bytes(&blob).unwrap();
+        let (back, fwd) = ([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]);
+        let mut rec = Recognizer::new(lib, None);
+        for s in &quick_strokes(&[back, fwd, back, back, fwd, back]) {
+            rec.push(s, |_| {});
+        }
+        let hist = rec.front.history();
+        let (oldest, newest) = (hist.oldest().unwrap(), hist.newest().unwrap());
+        let moving: Vec<u32> = (oldest..=newest)
+            .filter(|&i| hist.get(i).is_some_and(|r| r.token != STILL))
+            .collect();
+        assert_eq!(moving.len(), 6, "one run per stroke");
+        let whole = Candidate {
+            action: 0,
+            start: moving[0],
+            end: moving[5],
+            cost: 2 * FULL,
+            len: 6,
+            min_len: 3,
+            positions: 3,
+            cyclic: false,
+            shape: 0,
+        };
+        // The first punch, cut at the cheapest pause (not after `b f`, which needs an edit
+        // and leaves `b b f b`).
+        let first = rec.first_of_two(&whole).expect("two punches");
+        assert_eq!(
+            (first.start, first.end, first.cost, first.len),
+            (moving[0], moving[2], 0, 3)
+        );
+        // Read as one no dearer than apart, it is one performance (a run's strides after a
+        // breath); and a cyclic action's cycles are one bout.
+        assert_eq!(rec.first_of_two(&Candidate { cost: 0, ..whole }), None);
+        assert_eq!(
+            rec.first_of_two(&Candidate {
+                cyclic: true,
+                ..whole
+            }),
+            None
+        );
+        // A match that never paused is not cut.
+        assert_eq!(
+            rec.first_of_two(&Candidate {
+                end: moving[0],
+                len: 1,
+                ..whole
+            }),
+            None
+        );
     }
 }
