@@ -246,29 +246,8 @@ impl<'lib> Recognizer<'lib> {
                     _ => None,
                 };
                 if let Decision::Commit(c) = self.decider.stillness(still, longer) {
-                    let (floor, bounds) = if self.provisional.is_some() {
-                        self.report_floor
-                    } else {
-                        self.phrase_floor
-                    };
-                    let c = newest
-                        .and_then(|run| {
-                            whole_phrase(
-                                &self.library,
-                                self.front.history(),
-                                floor,
-                                bounds,
-                                run.wrapping_sub(1),
-                                &c,
-                            )
-                        })
-                        .unwrap_or(c);
-                    let c = self.first_of_two(&c).unwrap_or(c);
-                    // What moved after it while it was held (a turn begun while a run's match
-                    // waited for its next stride; a crouch right after a wave's last stroke) is
-                    // read afresh, as after a commit at a token.
-                    if self.commit(c, out) {
-                        self.feed_from(self.floor, out);
+                    if let Some(run) = newest {
+                        self.commit_at_pause(c, run.wrapping_sub(1), out);
                     }
                 } else if let Some(p) = self
                     .decider
@@ -344,33 +323,50 @@ impl<'lib> Recognizer<'lib> {
     fn flush_to(&mut self, out: &mut impl Sink) {
         // What followed a committed match is read on, as after any commit: the stream's end
         // is a pause long enough for everything pending.
+        let hist = self.front.history();
+        let Some(newest) = hist.newest() else {
+            self.held = None;
+            return;
+        };
+        let still = hist.get(newest).is_some_and(|r| r.token == STILL);
+        let last = if still {
+            newest.wrapping_sub(1)
+        } else {
+            newest
+        };
         for _ in 0..HISTORY_RUNS {
             let Some(c) = self.decider.pending() else {
                 break;
             };
-            let c = self.first_of_two(&c).unwrap_or(c);
-            if self.commit(c, out) {
-                self.feed_from(self.floor, out);
-            }
+            self.commit_at_pause(c, last, out);
         }
-        let hist = self.front.history();
-        if let Some(newest) = hist.newest() {
-            let still = hist.get(newest).is_some_and(|r| r.token == STILL);
-            let last = if still {
-                newest.wrapping_sub(1)
-            } else {
-                newest
-            };
-            if let Some(Nearest {
-                candidate: Some(c),
-                open: false,
-            }) = self.nearest_to(last, true)
-            {
-                out.note(|| self.note_of(&c, Why::Nearest));
-                self.commit(c, out);
-            }
+        if let Some(Nearest {
+            candidate: Some(c),
+            open: false,
+        }) = self.nearest_to(last, true)
+        {
+            out.note(|| self.note_of(&c, Why::Nearest));
+            self.commit(c, out);
         }
         self.held = None;
+    }
+
+    /// Commits `c` at a pause (or the stream's end) after run `last`: as the whole phrase
+    /// around it, the first of two performances if it read two as one, and then reads on
+    /// from what moved after it (a turn begun while a run's match waited for its next stride;
+    /// a crouch right after a wave's last stroke).
+    fn commit_at_pause(&mut self, c: Candidate, last: u32, out: &mut impl Sink) {
+        let (floor, bounds) = if self.provisional.is_some() {
+            self.report_floor
+        } else {
+            self.phrase_floor
+        };
+        let c =
+            whole_phrase(&self.library, self.front.history(), floor, bounds, last, &c).unwrap_or(c);
+        let c = self.first_of_two(&c).unwrap_or(c);
+        if self.commit(c, out) {
+            self.feed_from(self.floor, out);
+        }
     }
 
     /// How long event `h` stays held after it, µs of rest: [`CONTINUE_US`], or as long as its
