@@ -108,6 +108,8 @@ impl<'lib> Recognizer<'lib> {
     /// next punch's wind-up into its retraction (`b f b b`, `b+` reads on), then the whole next
     /// punch within its edits; a run's strides after a breath cost nothing more as one run.
     /// None when there is no such cut, when `c` is exact, or cyclic (its cycles are one bout).
+    // Once per commit, from two call sites: one out-of-line copy (flash).
+    #[inline(never)]
     pub(super) fn first_of_two(&self, c: &Candidate) -> Option<Candidate> {
         // An exact match costs no less apart; a cyclic action's cycles are one bout.
         if c.cyclic || c.cost == 0 {
@@ -116,24 +118,20 @@ impl<'lib> Recognizer<'lib> {
         let a = usize::from(c.action);
         let p = self.library.pattern(a)?;
         let hist = self.front.history();
-        // The moving tokens of `c`, and where pauses cut them: (tokens before, last run).
+        // The moving tokens of `c`, each one's run, and which follow a stillness (bit k).
         let mut tok = [STILL; HISTORY_RUNS];
+        let mut run = [0u32; HISTORY_RUNS];
+        let mut after_still = 0u64;
         let mut n = 0usize;
-        // Still runs lie between moving ones: at most half the history.
-        let mut cuts = [(0usize, 0u32); HISTORY_RUNS / 2];
-        let mut n_cuts = 0usize;
-        let (mut i, mut last_moving) = (c.start, c.start);
+        let mut i = c.start;
         for _ in 0..HISTORY_RUNS {
             let r = hist.get(i)?;
-            if r.token != STILL {
+            if r.token == STILL {
+                after_still |= 1 << n;
+            } else {
                 *tok.get_mut(n)? = r.token;
+                *run.get_mut(n)? = i;
                 n += 1;
-                last_moving = i;
-            } else if n > 0 {
-                if let Some(cut) = cuts.get_mut(n_cuts) {
-                    *cut = (n, last_moving);
-                    n_cuts += 1;
-                }
             }
             if i == c.end {
                 break;
@@ -141,26 +139,28 @@ impl<'lib> Recognizer<'lib> {
             i = i.wrapping_add(1);
         }
         let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
-        let whole = |t: &[Token]| {
+        let whole = |t: Option<&[Token]>| {
+            let t = t?;
             weighted_cost(&p, t, bound).filter(|&v| edits_fit(v, t.len().max(p.min_len())))
         };
-        let tokens = tok.get(..n)?;
-        // The cheapest split, the earliest among equals.
-        let (k, end, x, _) = cuts
-            .get(..n_cuts)?
-            .iter()
-            .filter(|&&(k, _)| k < n)
-            .filter_map(|&(k, end)| {
-                let (before, after) = tokens.split_at(k);
-                let (x, y) = (whole(before)?, whole(after)?);
-                Some((k, end, x, u16::from(x) + u16::from(y)))
-            })
-            .filter(|&(.., apart)| apart < u16::from(c.cost))
-            .min_by_key(|&(k, .., apart)| (apart, k))?;
+        // The cheapest cut, the earliest among equals: (tokens before it, their cost).
+        let mut best: Option<(usize, u8)> = None;
+        let mut cheapest = c.cost;
+        for k in (1..n).filter(|k| after_still >> k & 1 == 1) {
+            let (Some(x), Some(y)) = (whole(tok.get(..k)), whole(tok.get(k..n))) else {
+                continue;
+            };
+            if x.saturating_add(y) < cheapest {
+                cheapest = x.saturating_add(y);
+                best = Some((k, x));
+            }
+        }
+        let (k, cost) = best?;
+        let end = *run.get(k - 1)?;
         Some(Candidate {
             end,
-            cost: x,
-            len: k.min(usize::from(u16::MAX)) as u16,
+            cost,
+            len: k as u16,
             shape: shape_cost(
                 shape_of(&self.library, a, hist, c.start, end).unwrap_or(0),
                 k,
