@@ -308,9 +308,11 @@ impl<'lib> Recognizer<'lib> {
         }
     }
 
-    /// Commits the pending candidate, if any (end of stream); then, if no event took the
-    /// stream's last phrase, reports its nearest action as after a pause (a log that ends
-    /// right after a gesture no action matched closely keeps that gesture).
+    /// Ends the stream as a long pause would: commits the pending candidate as at a pause
+    /// (its whole phrase, the first of two performances read as one), reads on from what
+    /// moved after it until nothing is pending; then, if no event took the stream's last
+    /// phrase, reports its nearest action (a log that ends right after a gesture no action
+    /// matched closely keeps that gesture).
     pub fn flush(&mut self, emit: impl FnMut(ActionEvent)) {
         self.flush_to(&mut Quiet(emit));
     }

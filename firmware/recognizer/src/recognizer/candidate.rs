@@ -119,6 +119,7 @@ impl<'lib> Recognizer<'lib> {
         let p = self.library.pattern(a)?;
         let hist = self.front.history();
         // The moving tokens of `c`, each one's run, and which follow a stillness (bit k).
+        const _: () = assert!(HISTORY_RUNS < 64, "a token's stillness bit must fit a u64");
         let mut tok = [STILL; HISTORY_RUNS];
         let mut run = [0u32; HISTORY_RUNS];
         let mut after_still = 0u64;
