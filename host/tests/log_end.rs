@@ -37,8 +37,8 @@ fn rested(log: &PoseLog, seconds: f64) -> PoseLog {
 /// Every action of the generator at noise ×3, 60 performances each, the log ending 0.1 s after
 /// the motion and the same with 3 s of stillness after that, read by the shipped library: the
 /// actions reported differ for 13 of 720 logs (21 when the end committed the pending match as
-/// it stood). Most of those left are kicks read at the log's end and dropped after the rest
-/// (their cause not yet traced).
+/// it stood). Most of those left are kicks that no pattern matched, which the log's end gives
+/// to their nearest action and the rest does not (`simulate --why`: "no action read it").
 #[test]
 fn a_logs_end_reads_as_a_long_rest_would() {
     let b = blobs::load(None, None).expect("shipped library and effort model");
