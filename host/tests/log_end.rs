@@ -4,8 +4,8 @@
 //!
 //! At a pause the recognizer commits its pending match as the whole phrase around it, cuts
 //! two performances read as one, and reads on from what moved after. The stream's end used to
-//! commit the pending match as it stood and nothing more, so a gesture whose log ended during
-//! its hold was reported cut short, as another action, or not at all.
+//! commit the pending match as it stood and nothing more, so a gesture whose log ended before
+//! a pause committed it was reported cut short, as another action, or not at all.
 
 use figurine_host::link::blobs;
 use figurine_host::poselog::{PoseLog, PoseSample};
