@@ -38,13 +38,12 @@
 //! turn (much rotation, little path) is not mistaken for a settling. Everything here runs at
 //! commits only, never per sample.
 
-use crate::alignment::{weighted_cost, FULL};
 use crate::features::{Accum, SPEED};
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
 #[cfg(doc)]
 use crate::segment::CONTINUE_US;
-use crate::segment::{edits_fit, Candidate, CONTINUE_GAP_RUNS};
+use crate::segment::{whole_cost, Candidate, CONTINUE_GAP_RUNS};
 use crate::token::{token_signs, Token, ARM_M, STILL, TURN};
 
 /// Share of the held event's motion (path + [`ARM_M`] × angle) below which another action's
@@ -165,12 +164,7 @@ pub(crate) fn follow(
     let held_cost = |from: usize| {
         lib.pattern(usize::from(h.action))
             .filter(|_| whole)
-            .and_then(|p| {
-                let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
-                let tokens: &[Token] = tok.get(from..n)?;
-                let len = tokens.len().max(p.min_len());
-                weighted_cost(&p, tokens, bound).filter(|&v| edits_fit(v, len))
-            })
+            .and_then(|p| whole_cost(&p, tok.get(from..n)?))
     };
     // A wind-up first, whenever the event is still held: a held stroke that small is no
     // action whose rest the match could be (a kick's backswing, read as a punch, is not
@@ -236,6 +230,7 @@ fn motion(a: &Accum) -> f32 {
 mod tests {
     extern crate std;
     use super::*;
+    use crate::alignment::FULL;
     use crate::pattern::tests::seq_library;
     use crate::token::parse_token;
 

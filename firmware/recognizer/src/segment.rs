@@ -27,7 +27,9 @@
 //! that no action matched within its bound is offered to [`crate::nearest`] once the figurine
 //! has paused after it.
 
-use crate::alignment::FULL;
+use crate::alignment::{weighted_cost, FULL};
+use crate::pattern::Pattern;
+use crate::token::Token;
 
 /// Non-STILL tokens to wait after a candidate's end for a longer/better one.
 pub const LOOKAHEAD_TOKENS: u8 = 4;
@@ -69,6 +71,14 @@ pub const EDIT_SHARE: (usize, usize) = (2, 5);
 /// `cost` half-edits ([`crate::alignment`]) is close enough ([`EDIT_SHARE`]).
 pub const fn edits_fit(cost: u8, len: usize) -> bool {
     (cost as usize) * EDIT_SHARE.1 <= EDIT_SHARE.0 * 2 * len
+}
+
+/// The cost (half-edits) of reading all of `tokens` as one whole match of `p`, when that is
+/// within the pattern's edit bound and [`EDIT_SHARE`]; None otherwise. What [`crate::follow`]
+/// weighs an event and the match after it by, and the recognizer one match's two halves.
+pub fn whole_cost(p: &Pattern<'_>, tokens: &[Token]) -> Option<u8> {
+    let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
+    weighted_cost(p, tokens, bound).filter(|&v| edits_fit(v, tokens.len().max(p.min_len())))
 }
 
 /// Shortest action that is emitted, µs (first run's start to last run's end), unless it

@@ -6,11 +6,11 @@
 //! action's match that began inside it is still under way ([`Recognizer::longer_in_progress`]):
 //! a punch held at full reach after its forward stroke is not a run's stride.
 
-use crate::alignment::{prefix_cost, weighted_cost, FULL};
+use crate::alignment::{prefix_cost, FULL};
 use crate::automaton::{best_start, prefix_alive, top_level, Matches};
 use crate::history::{History, HISTORY_RUNS};
 use crate::pattern::Library;
-use crate::segment::{edits_fit, Candidate};
+use crate::segment::{edits_fit, whole_cost, Candidate};
 use crate::shape::{shape_cost, shape_of};
 use crate::token::{Token, STILL};
 
@@ -139,11 +139,7 @@ impl<'lib> Recognizer<'lib> {
             }
             i = i.wrapping_add(1);
         }
-        let bound = (usize::from(FULL) * p.max_edits()).min(usize::from(u8::MAX)) as u8;
-        let whole = |t: Option<&[Token]>| {
-            let t = t?;
-            weighted_cost(&p, t, bound).filter(|&v| edits_fit(v, t.len().max(p.min_len())))
-        };
+        let whole = |t: Option<&[Token]>| whole_cost(&p, t?);
         // The cheapest cut, the earliest among equals: (tokens before it, their cost).
         let mut best: Option<(usize, u8)> = None;
         let mut cheapest = c.cost;
