@@ -61,6 +61,23 @@ pub enum PoseLogError {
 }
 
 impl PoseLog {
+    /// This log with `seconds` of stillness after it: its last sample repeated at the log's
+    /// last step (at least 1 ms), as a figurine left resting would go on reporting. A log of
+    /// fewer than two samples is returned as it is.
+    pub fn rested(&self, seconds: f64) -> PoseLog {
+        let mut out = self.clone();
+        let n = self.samples.len();
+        if let (Some(a), Some(b)) = (self.samples.get(n.wrapping_sub(2)), self.samples.last()) {
+            let dt = (b.t - a.t).max(1e-3);
+            let steps = (seconds / dt) as usize;
+            out.samples.extend((1..=steps).map(|k| PoseSample {
+                t: b.t + dt * k as f64,
+                ..*b
+            }));
+        }
+        out
+    }
+
     /// Reads a pose log from a file; errors name the file and line.
     pub fn read_path(path: &Path) -> Result<Self, PoseLogError> {
         let file = std::fs::File::open(path).map_err(|source| PoseLogError::Io {
@@ -182,6 +199,34 @@ mod tests {
 
     fn parse(text: &str) -> Result<PoseLog, PoseLogError> {
         PoseLog::read(text.as_bytes(), Path::new("mem.csv"))
+    }
+
+    #[test]
+    fn a_rested_log_repeats_its_last_pose_at_its_last_step() {
+        let at = |t: f64, x: f64| PoseSample {
+            t,
+            pos: [x, 1.0, 0.0],
+            quat: [1.0, 0.0, 0.0, 0.0],
+        };
+        let log = PoseLog {
+            samples: vec![at(0.0, 0.0), at(0.01, 0.1), at(0.03, 0.2)],
+        };
+        let r = log.rested(0.1);
+        assert_eq!(r.samples.get(..3), Some(&log.samples[..]));
+        assert_eq!(r.samples.len(), 3 + 5);
+        for (k, s) in r.samples.iter().skip(3).enumerate() {
+            assert!(
+                (s.t - (0.03 + 0.02 * (k + 1) as f64)).abs() < 1e-12,
+                "{}",
+                s.t
+            );
+            assert_eq!((s.pos, s.quat), (at(0.0, 0.2).pos, at(0.0, 0.2).quat));
+        }
+        // Fewer than two samples give no step to repeat at.
+        let one = PoseLog {
+            samples: vec![at(0.0, 0.0)],
+        };
+        assert_eq!(one.rested(1.0), one);
     }
 
     #[test]
