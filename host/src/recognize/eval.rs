@@ -15,7 +15,10 @@
 //! - a toy held in a hand that talks ([`Handling::Talk`], `--isolated` logs): events per hour,
 //!   and the actions they were read as;
 //! - decision latency: when the event was emitted, after the performance's labelled end
-//!   (median and 90th percentile).
+//!   (median and 90th percentile);
+//! - the isolated gestures and handling logs read again, each followed by [`RESTED_S`] of
+//!   stillness ([`Figures::rested`]): a log is read to its end, 0.3–1.5 s after its motion,
+//!   and the stream's end decides some phrases otherwise than a figurine left resting does.
 //!
 //! The benchmarks (`figurine eval rest | sweep | real | repeat`) are dispatched by
 //! [`super::eval_cli`], each in its own module; they use what is here.
@@ -30,9 +33,10 @@ use super::effort_train::{gesture_features, train, Example, Trained};
 use super::learn::learn_action;
 use super::library::LibraryFile;
 use super::scoring::{
-    label_ok, notes_of, overlap, pair_events, run_doodle, ExtraEvents, ExtraKind,
+    label_ok, notes_of, overlap, pair_events, run_doodle, Ev, ExtraEvents, ExtraKind,
 };
 use super::simulate::load_effort;
+use crate::synth::sequence::{Doodle, Label};
 use crate::synth::{self, Action, Handling, Knobs, Range, TimeClass, WeightClass};
 use figurine_recognizer::EffortModel;
 
@@ -198,6 +202,59 @@ pub struct Figures {
     pub talk: TalkCounts,
     /// The counts behind the effort accuracies.
     pub effort_counts: EffortCounts,
+    /// The same isolated gestures and handling logs, each followed by [`RESTED_S`] of
+    /// stillness: what a figurine left resting reports, where a log's end may read otherwise.
+    pub rested: RestedCounts,
+}
+
+/// Stillness appended to each isolated gesture and handling log for [`Figures::rested`], s:
+/// longer than any hold a decision waits for and than the 2.5 s after which partial matches
+/// are forgotten, so nothing is left for the stream's end to decide.
+pub const RESTED_S: f64 = 3.0;
+
+/// [`Figures::rested`]: isolated gestures read as played, and handling logs with any event,
+/// when each log is followed by [`RESTED_S`] of stillness.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RestedCounts {
+    /// Isolated gestures whose main event names the action played.
+    pub isolated_ok: usize,
+    /// Handling logs (every kind but the hand that talks) with any event.
+    pub handling_loud: usize,
+}
+
+impl RestedCounts {
+    /// Sums two counts (seed pairs).
+    pub fn add(&mut self, o: RestedCounts) {
+        self.isolated_ok += o.isolated_ok;
+        self.handling_loud += o.handling_loud;
+    }
+
+    /// These counts in words, out of `isolated` gestures and `handling` logs.
+    pub fn words(&self, isolated: usize, handling: usize) -> String {
+        format!(
+            "left resting {RESTED_S} s after each log: isolated {} of {isolated} read as \
+             played, handling silent on {} of {handling} logs",
+            self.isolated_ok,
+            handling - self.handling_loud.min(handling)
+        )
+    }
+}
+
+/// The event of `evs` that overlaps label `l` most, if any overlaps it.
+fn main_event<'a>(evs: &'a [Ev], l: &Label) -> Option<&'a Ev> {
+    evs.iter()
+        .max_by(|a, b| {
+            overlap(a.start, a.end, l.start, l.end)
+                .total_cmp(&overlap(b.start, b.end, l.start, l.end))
+        })
+        .filter(|e| overlap(e.start, e.end, l.start, l.end) > 0.0)
+}
+
+/// `d` with [`RESTED_S`] of stillness after its log.
+fn rested(d: &Doodle) -> Doodle {
+    let mut r = d.clone();
+    r.log = d.log.rested(RESTED_S);
+    r
 }
 
 /// How many correctly recognised isolated gestures there were, and of them how many had their
@@ -323,14 +380,11 @@ pub fn evaluate(
             let d = synth::examples(seed, knobs, action, 1, None).remove(0);
             let l = &d.labels[0];
             let evs = run_doodle(&d, &names, &blob, effort)?;
-            let main = evs
-                .iter()
-                .max_by(|a, b| {
-                    overlap(a.start, a.end, l.start, l.end)
-                        .total_cmp(&overlap(b.start, b.end, l.start, l.end))
-                })
-                .filter(|e| overlap(e.start, e.end, l.start, l.end) > 0.0);
+            let main = main_event(&evs, l);
             let got = main.map_or("none".to_string(), |e| e.action.clone());
+            let at_rest = run_doodle(&rested(&d), &names, &blob, effort)?;
+            f.rested.isolated_ok +=
+                usize::from(main_event(&at_rest, l).is_some_and(|e| e.action == l.action));
             if got == l.action {
                 ok += 1;
                 let (t, w) = label_ok(l, main.unwrap_or(&evs[0]));
@@ -404,6 +458,8 @@ pub fn evaluate(
             let evs = run_doodle(&d, &names, &blob, effort)?;
             events += evs.len();
             loud += usize::from(!evs.is_empty());
+            f.rested.handling_loud +=
+                usize::from(!run_doodle(&rested(&d), &names, &blob, effort)?.is_empty());
             if args.verbose && !evs.is_empty() {
                 let t = super::learn::tokenize_gesture(&d.log);
                 let got: Vec<&str> = evs.iter().map(|e| e.action.as_str()).collect();
@@ -620,6 +676,14 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         "Handling that plays no action: silent on {:.1}% ({})",
         100.0 * f.silent(),
         kinds.join(", ")
+    );
+    let (isolated, handling) = (
+        f.per_action.iter().map(|a| a.2).sum(),
+        f.handling.iter().map(|h| h.3).sum(),
+    );
+    println!(
+        "As a figurine {} (the figures above read each log to its end)",
+        f.rested.words(isolated, handling)
     );
     println!(
         "Held in a hand that talks, playing no action ({} logs): {}{}",

@@ -7,7 +7,9 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Result};
 
-use super::eval::{evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures, TalkCounts};
+use super::eval::{
+    evaluate, prepare, quantiles, EffortCounts, EvalArgs, Figures, RestedCounts, TalkCounts,
+};
 
 /// Test seeds of successive pairs are this far apart (the training seeds are consecutive).
 pub const TEST_SEED_STEP: u64 = 1000;
@@ -81,6 +83,8 @@ pub struct Tally {
     pub talk: TalkCounts,
     /// Isolated gestures by (action played, read as or "none"), read as another.
     pub misreads: BTreeMap<(String, String), usize>,
+    /// The same isolated gestures and handling logs, each followed by stillness.
+    pub rested: RestedCounts,
 }
 
 impl Tally {
@@ -96,6 +100,7 @@ impl Tally {
             self.handling += n;
         }
         self.talk.add(&f.talk);
+        self.rested.add(f.rested);
         for (played, read, n) in &f.confusions {
             *self
                 .misreads
@@ -128,7 +133,7 @@ impl Tally {
         format!(
             "counts over the pairs: isolated {} of {} read as played, of them Time right {}, \
              Weight {}, both {}; handling silent on {} of {} logs; held in a hand that \
-             talks, {}",
+             talks, {}; {}",
             self.isolated_ok,
             self.isolated,
             self.effort.time,
@@ -136,7 +141,8 @@ impl Tally {
             self.effort.state,
             self.silent,
             self.handling,
-            self.talk.words()
+            self.talk.words(),
+            self.rested.words(self.isolated, self.handling)
         )
     }
 }
@@ -306,6 +312,10 @@ mod tests {
                 ("walk".into(), "run".into(), 10 - ok),
                 ("jump".into(), "none".into(), 1),
             ],
+            rested: RestedCounts {
+                isolated_ok: ok + 9,
+                handling_loud: loud + 1,
+            },
             ..Figures::default()
         };
         let mut t = Tally::default();
@@ -326,7 +336,8 @@ mod tests {
             t.line(),
             "counts over the pairs: isolated 37 of 40 read as played, of them Time right 35, \
              Weight 33, both 31; handling silent on 33 of 40 logs; held in a hand that talks, \
-             6 events in 3.0 minutes, 120 per hour"
+             6 events in 3.0 minutes, 120 per hour; left resting 3 s after each log: \
+             isolated 35 of 40 read as played, handling silent on 31 of 40 logs"
         );
         assert_eq!(
             t.misreads_line().as_deref(),
