@@ -7,15 +7,46 @@
 //! commit the pending match as it stood and nothing more, so a gesture whose log ended before
 //! a pause committed it was reported cut short, as another action, or not at all.
 
+use std::process::Command;
+
+use figurine_host::events::read_events;
 use figurine_host::link::blobs;
 use figurine_host::poselog::PoseLog;
 use figurine_host::recognize::simulate::{load_effort, simulate_log};
-use figurine_host::synth::{self, Action, Knobs, Range};
+use figurine_host::synth::{self, Action, Doodle, Knobs, Range};
 
-/// `log` up to `end` s.
-fn cut(log: &PoseLog, end: f64) -> PoseLog {
+mod scratch;
+use scratch::Scratch;
+
+/// `d`'s log cut 0.1 s after the end of its last label.
+fn ending_soon(d: &Doodle) -> PoseLog {
+    let end = d.labels.iter().map(|l| l.end).fold(0.0, f64::max) + 0.1;
     PoseLog {
-        samples: log.samples.iter().filter(|s| s.t <= end).copied().collect(),
+        samples: d
+            .log
+            .samples
+            .iter()
+            .filter(|s| s.t <= end)
+            .copied()
+            .collect(),
+    }
+}
+
+/// The actions the shipped library reads in a log, in order.
+fn shipped_reader() -> impl Fn(&PoseLog) -> Vec<String> {
+    let b = blobs::load(None, None).expect("shipped library and effort model");
+    let effort = load_effort(None).expect("shipped effort model");
+    move |log| {
+        let sim = simulate_log(log, &b.names, &b.library, Some(effort)).unwrap();
+        sim.records.into_iter().map(|r| r.action).collect()
+    }
+}
+
+/// The generator's every knob at its default but the tracker's noise, ×3.
+fn noise_x3() -> Knobs {
+    Knobs {
+        noise: Range::new(3.0, 3.0),
+        ..Knobs::default()
     }
 }
 
@@ -29,21 +60,11 @@ fn cut(log: &PoseLog, end: f64) -> PoseLog {
 /// taken", 2026-12-07 fourth session).
 #[test]
 fn a_logs_end_reads_as_a_long_rest_would() {
-    let b = blobs::load(None, None).expect("shipped library and effort model");
-    let effort = load_effort(None).expect("shipped effort model");
-    let knobs = Knobs {
-        noise: Range::new(3.0, 3.0),
-        ..Knobs::default()
-    };
-    let actions = |log: &PoseLog| -> Vec<String> {
-        let sim = simulate_log(log, &b.names, &b.library, Some(effort)).unwrap();
-        sim.records.into_iter().map(|r| r.action).collect()
-    };
+    let (actions, knobs) = (shipped_reader(), noise_x3());
     let mut differ = Vec::new();
     for (i, &action) in Action::ALL.iter().enumerate() {
         for d in synth::examples(9_100 + i as u64, &knobs, action, 60, None) {
-            let end = d.labels.iter().map(|l| l.end).fold(0.0, f64::max) + 0.1;
-            let log = cut(&d.log, end);
+            let log = ending_soon(&d);
             let (at_end, resting) = (actions(&log), actions(&log.rested(3.0)));
             if at_end != resting {
                 differ.push((action.name(), at_end, resting));
@@ -52,4 +73,46 @@ fn a_logs_end_reads_as_a_long_rest_would() {
     }
     println!("differ: {} {differ:?}", differ.len());
     assert!(differ.len() <= 16, "{} differ: {differ:?}", differ.len());
+}
+
+/// `figurine simulate --rest SECONDS` reads a log as the figurine left resting that long after
+/// it: on a kick whose log ends 0.1 s after it and which the end reads otherwise than a rest
+/// (the test above), the command with `--rest 3` reports what the resting figurine does, and
+/// without it what the end does. A rest outside 0–3600 s, or not a number, is refused.
+#[test]
+fn simulate_rest_reads_a_log_as_a_resting_figurine() {
+    let (actions, knobs) = (shipped_reader(), noise_x3());
+    let (log, at_end, resting) = synth::examples(9_105, &knobs, Action::Kick, 60, None)
+        .into_iter()
+        .map(|d| {
+            let log = ending_soon(&d);
+            let (a, r) = (actions(&log), actions(&log.rested(3.0)));
+            (log, a, r)
+        })
+        .find(|(_, a, r)| a != r)
+        .expect("a kick the log's end reads otherwise than a rest");
+    let dir = Scratch::new("log-end", "rest");
+    let path = dir.join("kick.csv");
+    log.write_path(&path).unwrap();
+    let path = path.to_str().unwrap();
+    let cli = |extra: &[&str]| -> (bool, Vec<String>, String) {
+        let out = Command::new(env!("CARGO_BIN_EXE_figurine"))
+            .arg("simulate")
+            .args(extra)
+            .args(["--jsonl", path])
+            .output()
+            .unwrap();
+        let events = read_events(&out.stdout[..], std::path::Path::new("stdout")).unwrap();
+        (
+            out.status.success(),
+            events.into_iter().map(|e| e.action).collect(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    assert_eq!(cli(&[]), (true, at_end, String::new()));
+    assert_eq!(cli(&["--rest", "3"]), (true, resting, String::new()));
+    for bad in ["-1", "3601", "NaN"] {
+        let (ok, _, err) = cli(&[&format!("--rest={bad}")]);
+        assert!(!ok && err.contains("--rest"), "--rest={bad}: {err}");
+    }
 }

@@ -10,7 +10,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use figurine_recognizer::history::Run;
 use figurine_recognizer::intake::MAX_GAP_US;
@@ -47,9 +47,19 @@ pub struct SimulateArgs {
     /// action, with the rule that decided it.
     #[arg(long, conflicts_with = "jsonl")]
     pub why: bool,
+    /// Read the log as if the figurine had rested this many seconds after its last sample (its
+    /// last pose repeated at its last step): what a live figurine reports. Without it the log's
+    /// end decides what is still pending, and a phrase no pattern matched or could go on from
+    /// is then given its nearest action, which a resting figurine does not do.
+    #[arg(long, value_name = "SECONDS")]
+    pub rest: Option<f64>,
     /// The pose log (CSV).
     pub log: PathBuf,
 }
+
+/// Longest stillness `simulate --rest` appends, s: an hour, far past every wait of the
+/// decision stage, bounding the samples it adds (3.6 M at 1 kHz).
+pub const MAX_REST_S: f64 = 3600.0;
 
 /// Result of simulating one log.
 #[derive(Debug, Clone)]
@@ -128,7 +138,13 @@ pub fn simulate_log(
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let (lib, blob) = load_library(args.library.as_deref())?;
     let effort = load_effort(args.effort.as_deref())?;
-    let log = PoseLog::read_path(&args.log)?;
+    let mut log = PoseLog::read_path(&args.log)?;
+    if let Some(rest) = args.rest {
+        if !(0.0..=MAX_REST_S).contains(&rest) {
+            bail!("--rest {rest}: give seconds of stillness from 0 to {MAX_REST_S}");
+        }
+        log = log.rested(rest);
+    }
     let sim = simulate_log(&log, &lib.names(), &blob, Some(effort))
         .with_context(|| format!("simulating {}", args.log.display()))?;
     let stdout = std::io::stdout();
