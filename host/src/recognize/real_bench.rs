@@ -15,7 +15,7 @@ use clap::Args;
 use serde::Deserialize;
 
 use super::doodle::{doodle, Doodle, DoodleSpec};
-use super::eval::learn_synth_library;
+use super::eval::{learn_synth_library, RESTED_S};
 use super::learn::learn_action;
 use super::library::LibraryFile;
 use super::separate::separate;
@@ -169,12 +169,26 @@ pub struct TakeScore {
     pub found: Vec<bool>,
     /// Length of the take's doodle, seconds.
     pub seconds: f64,
+    /// [`Self::events`], the take followed by [`RESTED_S`] of stillness: what a figurine left
+    /// resting reports, where the take's end may decide otherwise.
+    pub rested_events: Vec<String>,
+    /// [`Self::found`], the take followed by [`RESTED_S`] of stillness.
+    pub rested_found: Vec<bool>,
 }
 
 impl TakeScore {
     /// Labels matched by an event.
     pub fn hits(&self) -> usize {
         self.found.iter().filter(|&&f| f).count()
+    }
+
+    /// This take as a figurine left resting after it reads it.
+    pub fn rested(&self) -> TakeScore {
+        TakeScore {
+            events: self.rested_events.clone(),
+            found: self.rested_found.clone(),
+            ..self.clone()
+        }
     }
 }
 
@@ -257,25 +271,33 @@ pub fn score_takes(
             let stem = format!("{}{}", t.take, window(t)).replace(['/', '.', ' '], "_");
             std::fs::write(dir.join(format!("{stem}_{}.csv", t.joint)), text)?;
         }
-        let sim = simulate_log(&d.log, names, blob, effort)?;
-        let mut used = vec![false; sim.records.len()];
-        let mut found = Vec::with_capacity(labels.len());
-        for (action, span) in &labels {
-            let hit = sim.records.iter().enumerate().position(|(i, r)| {
-                !used[i] && &r.action == action && overlaps((r.start, r.end), *span)
-            });
-            if let Some(i) = hit {
-                used[i] = true;
+        // The events read in `log`, and per label whether one of them matched it.
+        let read = |log: &PoseLog| -> Result<(Vec<String>, Vec<bool>)> {
+            let sim = simulate_log(log, names, blob, effort)?;
+            let mut used = vec![false; sim.records.len()];
+            let mut found = Vec::with_capacity(labels.len());
+            for (action, span) in &labels {
+                let hit = sim.records.iter().enumerate().position(|(i, r)| {
+                    !used[i] && &r.action == action && overlaps((r.start, r.end), *span)
+                });
+                if let Some(i) = hit {
+                    used[i] = true;
+                }
+                found.push(hit.is_some());
             }
-            found.push(hit.is_some());
-        }
+            Ok((sim.records.into_iter().map(|r| r.action).collect(), found))
+        };
+        let (events, found) = read(&d.log)?;
+        let (rested_events, rested_found) = read(&d.log.rested(RESTED_S))?;
         out.push(TakeScore {
             take: format!("{}{} ({})", t.take, window(t), t.joint),
             labels: labels.into_iter().map(|(a, _)| a).collect(),
-            events: sim.records.iter().map(|r| r.action.clone()).collect(),
+            events,
             found,
             seconds: d.log.samples.last().map_or(0.0, |l| l.t)
                 - d.log.samples.first().map_or(0.0, |f| f.t),
+            rested_events,
+            rested_found,
         });
     }
     Ok(out)
@@ -438,6 +460,16 @@ pub fn report(runs: &[Vec<TakeScore>]) -> String {
         "takes that play no action: {events} events in {:.1} minutes, {rate:.0} per hour",
         hours * 60.0
     );
+    let rested: Vec<TakeScore> = runs.iter().flatten().map(TakeScore::rested).collect();
+    let (recall, precision) = recall_precision(&rested);
+    let (rate, events, _) = idle_per_hour(&rested);
+    let _ = writeln!(
+        out,
+        "as a figurine left resting {RESTED_S} s after each take: recall {:.1}%, precision \
+         {:.1}%; the takes that play no action {events} events, {rate:.0} per hour",
+        100.0 * recall,
+        100.0 * precision
+    );
     out
 }
 
@@ -550,9 +582,22 @@ mod tests {
             events: vec![String::new(); events],
             found: (0..labels).map(|i| i < hits).collect(),
             seconds: 1.0,
+            rested_events: Vec::new(),
+            rested_found: Vec::new(),
         };
         assert_eq!(recall_precision(&[s(2, 4, 1), s(2, 0, 0)]), (0.25, 0.25));
         assert_eq!(recall_precision(&[]), (1.0, 1.0));
+    }
+
+    #[test]
+    fn a_take_read_at_rest_keeps_its_labels_and_length() {
+        let mut t = score(&["turn", "turn"], &["turn", "turn"], &[true, true]);
+        t.rested_events = vec!["turn".into()];
+        t.rested_found = vec![true, false];
+        let r = t.rested();
+        assert_eq!((r.labels, r.seconds), (t.labels.clone(), t.seconds));
+        assert_eq!(recall_precision(&[t.rested()]), (0.5, 1.0));
+        assert_eq!((r.events, r.found), (t.rested_events, t.rested_found));
     }
 
     fn score(labels: &[&str], events: &[&str], found: &[bool]) -> TakeScore {
@@ -562,6 +607,8 @@ mod tests {
             events: events.iter().map(|e| e.to_string()).collect(),
             found: found.to_vec(),
             seconds: 36.0,
+            rested_events: Vec::new(),
+            rested_found: Vec::new(),
         }
     }
 
