@@ -15,10 +15,10 @@ use anyhow::{bail, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::eval::learn_synth_library;
+use super::eval::{learn_synth_library, RESTED_S};
 use super::scoring::{pair_events, run_doodle, Ev};
 use super::simulate::load_effort;
-use crate::synth::{self, Action, Knobs, Label, Range};
+use crate::synth::{self, Action, Doodle, Knobs, Label, Range};
 
 /// Default pause between repetitions, seconds: a breath, or none to speak of.
 pub const DEFAULT_PAUSE_S: Range = Range { lo: 0.05, hi: 0.4 };
@@ -90,8 +90,41 @@ fn outcome(action: Action, truth: &[Label], evs: &[Ev]) -> Outcome {
     }
 }
 
-/// Outcomes of every doodle of one seed pair, by action (in [`Action::ALL`] order).
-fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<Outcome>>> {
+/// The share of exact doodles (all, one-shot actions, continuing ones) and the events'
+/// precision, recall and F1 over `outcomes`, each with the action it played.
+fn scores<'a>(outcomes: impl Iterator<Item = (Action, &'a Outcome)>) -> [f64; 6] {
+    let (mut all, mut by_kind) = (Outcome::default(), [(0usize, 0usize); 2]);
+    for (action, o) in outcomes {
+        let k = &mut by_kind[usize::from(action.continues())];
+        k.0 += usize::from(o.exact());
+        k.1 += 1;
+        all.due += o.due;
+        all.of_action += o.of_action;
+        all.other += o.other;
+        all.matched += o.matched;
+    }
+    let share = |a: usize, b: usize| a as f64 / b.max(1) as f64;
+    let p = share(all.matched, all.of_action + all.other);
+    let r = share(all.matched, all.due);
+    let f1 = if p + r > 0.0 {
+        2.0 * p * r / (p + r)
+    } else {
+        0.0
+    };
+    let [one, on] = by_kind;
+    [
+        share(one.0 + on.0, one.1 + on.1),
+        share(one.0, one.1),
+        share(on.0, on.1),
+        p,
+        r,
+        f1,
+    ]
+}
+
+/// Outcomes of every doodle of one seed pair, by action (in [`Action::ALL`] order): as the
+/// log ends, and followed by [`RESTED_S`] of stillness (a figurine left resting).
+fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<(Outcome, Outcome)>>> {
     let knobs = Knobs {
         pause_s: args.pause,
         ..Knobs::default()
@@ -114,6 +147,11 @@ fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<Outcome>>> {
                     let t = truth(action, &d.labels);
                     let evs = run_doodle(&d, &names, &blob, effort)?;
                     let o = outcome(action, &t, &evs);
+                    let rested = Doodle {
+                        log: d.log.rested(RESTED_S),
+                        ..d.clone()
+                    };
+                    let at_rest = outcome(action, &t, &run_doodle(&rested, &names, &blob, effort)?);
                     if args.verbose && !o.exact() {
                         let got: Vec<String> = evs
                             .iter()
@@ -135,7 +173,7 @@ fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<Outcome>>> {
                             args.train_seed + pair as u64
                         );
                     }
-                    Ok(o)
+                    Ok((o, at_rest))
                 })
                 .collect()
         })
@@ -151,7 +189,7 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
         "learning {} libraries and playing {} doodles per action each…",
         args.pairs, args.per_action
     );
-    let pairs: Vec<Vec<Vec<Outcome>>> = (0..args.pairs)
+    let pairs: Vec<Vec<Vec<(Outcome, Outcome)>>> = (0..args.pairs)
         .into_par_iter()
         .map(|p| run_pair(args, p))
         .collect::<Result<_>>()?;
@@ -168,11 +206,8 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
         "{:<10} {:<10} {:>7} {:>16} {:>8}",
         "action", "truth", "exact", "events/doodle", "others"
     );
-    let mut all = Outcome::default();
-    let (mut exact, mut doodles) = (0usize, 0usize);
-    let mut by_kind = [(0usize, 0usize); 2];
     for (ai, &action) in Action::ALL.iter().enumerate() {
-        let os: Vec<&Outcome> = pairs.iter().flat_map(|p| &p[ai]).collect();
+        let os: Vec<&Outcome> = pairs.iter().flat_map(|p| &p[ai]).map(|o| &o.0).collect();
         let n = os.len();
         let ex = os.iter().filter(|o| o.exact()).count();
         let sum = os.iter().fold(Outcome::default(), |a, o| Outcome {
@@ -194,36 +229,26 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
             sum.due as f64 / n.max(1) as f64,
             sum.other
         );
-        let k = &mut by_kind[usize::from(action.continues())];
-        k.0 += ex;
-        k.1 += n;
-        exact += ex;
-        doodles += n;
-        all.due += sum.due;
-        all.of_action += sum.of_action;
-        all.other += sum.other;
-        all.matched += sum.matched;
     }
-    let events = all.of_action + all.other;
-    let p = all.matched as f64 / events.max(1) as f64;
-    let r = all.matched as f64 / all.due.max(1) as f64;
-    let f1 = if p + r > 0.0 {
-        2.0 * p * r / (p + r)
-    } else {
-        0.0
+    let played = |end: bool| {
+        let pairs = &pairs;
+        Action::ALL
+            .iter()
+            .enumerate()
+            .flat_map(move |(ai, &action)| {
+                pairs
+                    .iter()
+                    .flat_map(move |p| &p[ai])
+                    .map(move |o| (action, if end { &o.0 } else { &o.1 }))
+            })
     };
-    let share = |(a, b): (usize, usize)| 100.0 * a as f64 / b.max(1) as f64;
+    let [ex, one, on, p, r, f1] = scores(played(true)).map(|v| 100.0 * v);
+    println!("exact: {ex:.1}% of doodles (one-shot actions {one:.1}%, continuing ones {on:.1}%)");
+    println!("repeat: precision {p:.1}%  recall {r:.1}%  F1 {f1:.1}%");
+    let [ex, one, on, p, r, f1] = scores(played(false)).map(|v| 100.0 * v);
     println!(
-        "exact: {:.1}% of doodles (one-shot actions {:.1}%, continuing ones {:.1}%)",
-        share((exact, doodles)),
-        share(by_kind[0]),
-        share(by_kind[1])
-    );
-    println!(
-        "repeat: precision {:.1}%  recall {:.1}%  F1 {:.1}%",
-        100.0 * p,
-        100.0 * r,
-        100.0 * f1
+        "as a figurine left resting {RESTED_S} s after each doodle: exact {ex:.1}% (one-shot \
+         {one:.1}%, continuing {on:.1}%), precision {p:.1}%  recall {r:.1}%  F1 {f1:.1}%"
     );
     Ok(())
 }
@@ -268,5 +293,37 @@ mod tests {
         );
         assert_eq!((split.due, split.of_action, split.matched), (1, 2, 1));
         assert!(!split.exact());
+    }
+
+    #[test]
+    fn scores_split_exact_doodles_by_kind_and_count_events_over_all() {
+        let exact = Outcome {
+            due: 2,
+            of_action: 2,
+            other: 0,
+            matched: 2,
+        };
+        let merged = Outcome {
+            due: 2,
+            of_action: 1,
+            other: 1,
+            matched: 1,
+        };
+        let walk = Outcome {
+            due: 1,
+            of_action: 1,
+            other: 0,
+            matched: 1,
+        };
+        let played = [
+            (Action::Jump, &exact),
+            (Action::Jump, &merged),
+            (Action::Walk, &walk),
+        ];
+        let [all, one, on, p, r, f1] = scores(played.into_iter());
+        assert_eq!((all, one, on), (2.0 / 3.0, 0.5, 1.0));
+        assert_eq!((p, r), (4.0 / 5.0, 4.0 / 5.0));
+        assert!((f1 - 0.8).abs() < 1e-12);
+        assert_eq!(scores(std::iter::empty()), [0.0; 6]);
     }
 }
