@@ -251,7 +251,7 @@ fn main_event<'a>(evs: &'a [Ev], l: &Label) -> Option<&'a Ev> {
 }
 
 /// `d` with [`RESTED_S`] of stillness after its log.
-fn rested(d: &Doodle) -> Doodle {
+pub(super) fn rested(d: &Doodle) -> Doodle {
     let mut r = d.clone();
     r.log = d.log.rested(RESTED_S);
     r

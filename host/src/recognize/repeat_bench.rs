@@ -15,10 +15,10 @@ use anyhow::{bail, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::eval::{learn_synth_library, RESTED_S};
+use super::eval::{learn_synth_library, rested, RESTED_S};
 use super::scoring::{pair_events, run_doodle, Ev};
 use super::simulate::load_effort;
-use crate::synth::{self, Action, Doodle, Knobs, Label, Range};
+use crate::synth::{self, Action, Knobs, Label, Range};
 
 /// Default pause between repetitions, seconds: a breath, or none to speak of.
 pub const DEFAULT_PAUSE_S: Range = Range { lo: 0.05, hi: 0.4 };
@@ -147,11 +147,8 @@ fn run_pair(args: &RepeatArgs, pair: usize) -> Result<Vec<Vec<(Outcome, Outcome)
                     let t = truth(action, &d.labels);
                     let evs = run_doodle(&d, &names, &blob, effort)?;
                     let o = outcome(action, &t, &evs);
-                    let rested = Doodle {
-                        log: d.log.rested(RESTED_S),
-                        ..d.clone()
-                    };
-                    let at_rest = outcome(action, &t, &run_doodle(&rested, &names, &blob, effort)?);
+                    let at_rest =
+                        outcome(action, &t, &run_doodle(&rested(&d), &names, &blob, effort)?);
                     if args.verbose && !o.exact() {
                         let got: Vec<String> = evs
                             .iter()
