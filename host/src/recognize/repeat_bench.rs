@@ -294,24 +294,13 @@ mod tests {
 
     #[test]
     fn scores_split_exact_doodles_by_kind_and_count_events_over_all() {
-        let exact = Outcome {
-            due: 2,
-            of_action: 2,
-            other: 0,
-            matched: 2,
+        let o = |due, of_action, other, matched| Outcome {
+            due,
+            of_action,
+            other,
+            matched,
         };
-        let merged = Outcome {
-            due: 2,
-            of_action: 1,
-            other: 1,
-            matched: 1,
-        };
-        let walk = Outcome {
-            due: 1,
-            of_action: 1,
-            other: 0,
-            matched: 1,
-        };
+        let (exact, merged, walk) = (o(2, 2, 0, 2), o(2, 1, 1, 1), o(1, 1, 0, 1));
         let played = [
             (Action::Jump, &exact),
             (Action::Jump, &merged),
