@@ -15,7 +15,8 @@ use figurine_protocol::{DeviceToHost, HostToDevice};
 /// `Stats::samples_dropped`; a command waits for room (the link then back-pressures).
 /// 32 × 84 B ≈ 2.7 KiB; at 1 kHz this absorbs 32 ms of engine stall.
 pub const INBOX_CAPACITY: usize = 32;
-/// Messages waiting for the transmitter. When full, the engine waits: events are never dropped.
+/// Messages waiting for the transmitter. When full, the engine waits: no event is dropped here
+/// (what one recognizer call hands back waits in the engine's `EVENTS_PER_CALL` before it).
 pub const OUTBOX_CAPACITY: usize = 16;
 
 /// Link receiver → engine.

@@ -19,6 +19,15 @@ use crate::board::{self, Flash, Stopwatch};
 use crate::channels::{send_to_host, INBOX, INBOX_CAPACITY};
 use crate::stats;
 
+/// Room for the events one `push` or `flush` of the recognizer hands back before they are
+/// queued for the host (48 B each). The most measured is 2 from one sample and 3 from one
+/// flush (`host/tests/events_per_call.rs` asserts at most half this room over generated
+/// sequences, repetitions and a hand that talks). An event past the room is dropped, since
+/// the recognizer's callback cannot wait for the queue: not counted (`Stats` has no field for
+/// it, and one changes the wire format) nor logged (a `defmt` warning at either call costs
+/// 640 B of flash, past the 64 KiB budget).
+pub const EVENTS_PER_CALL: usize = 6;
+
 /// Identifies this firmware build in `Hello` (FNV-1a of crate version and board name).
 pub const BUILD_ID: u32 = fnv1a(concat!(
     env!("CARGO_PKG_NAME"),
@@ -100,11 +109,11 @@ impl Engine {
             pos: p.position_m(),
             quat: p.orientation(),
         };
-        let mut events: heapless::Vec<figurine_recognizer::ActionEvent, 4> = heapless::Vec::new();
+        let mut events: heapless::Vec<figurine_recognizer::ActionEvent, EVENTS_PER_CALL> =
+            heapless::Vec::new();
         let watch = Stopwatch::start();
         self.recognizer.push(&sample, |e| {
-            // More than 4 events from one sample cannot happen (one commit per token run,
-            // at most a few runs per sample); a full vector would drop, counted below.
+            // Past the room, dropped (`EVENTS_PER_CALL`).
             let _ = events.push(e);
         });
         let cycles = watch.cycles();
@@ -151,8 +160,10 @@ impl Engine {
     /// Ends the current session: emits any action still waiting for its look-ahead, then
     /// restarts recognition, sequence tracking and statistics (the blobs stay).
     async fn reset(&mut self) {
-        let mut events: heapless::Vec<figurine_recognizer::ActionEvent, 4> = heapless::Vec::new();
+        let mut events: heapless::Vec<figurine_recognizer::ActionEvent, EVENTS_PER_CALL> =
+            heapless::Vec::new();
         self.recognizer.flush(|e| {
+            // Past the room, dropped (`EVENTS_PER_CALL`).
             let _ = events.push(e);
         });
         for e in events {
