@@ -16,7 +16,7 @@
 //!   and the actions they were read as;
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile);
-//! - the isolated gestures and handling logs read again, each followed by [`RESTED_S`] of
+//! - the isolated gestures, handling logs and sequences read again, each followed by [`RESTED_S`] of
 //!   stillness ([`Figures::rested`]): a log is read to its end, 0.3–1.5 s after its motion,
 //!   and the stream's end decides some phrases otherwise than a figurine left resting does.
 //!
@@ -202,24 +202,27 @@ pub struct Figures {
     pub talk: TalkCounts,
     /// The counts behind the effort accuracies.
     pub effort_counts: EffortCounts,
-    /// The same isolated gestures and handling logs, each followed by [`RESTED_S`] of
-    /// stillness: what a figurine left resting reports, where a log's end may read otherwise.
+    /// The same isolated gestures, handling logs and sequences, each followed by [`RESTED_S`]
+    /// of stillness: what a figurine left resting reports, where a log's end may read otherwise.
     pub rested: RestedCounts,
 }
 
-/// Stillness appended to each isolated gesture and handling log for [`Figures::rested`], s:
+/// Stillness appended to each isolated gesture, handling log and sequence for
+/// [`Figures::rested`], s:
 /// longer than any hold a decision waits for and than the 2.5 s after which partial matches
 /// are forgotten, so nothing is left for the stream's end to decide.
 pub const RESTED_S: f64 = 3.0;
 
-/// [`Figures::rested`]: isolated gestures read as played, and handling logs with any event,
-/// when each log is followed by [`RESTED_S`] of stillness.
+/// [`Figures::rested`]: isolated gestures read as played, handling logs with any event and
+/// sequence events matched, when each log is followed by [`RESTED_S`] of stillness.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RestedCounts {
     /// Isolated gestures whose main event names the action played.
     pub isolated_ok: usize,
     /// Handling logs (every kind but the hand that talks) with any event.
     pub handling_loud: usize,
+    /// Sequences: labels matched by an event, events, labels (as for [`Figures::seq_prf`]).
+    pub seq: (usize, usize, usize),
 }
 
 impl RestedCounts {
@@ -227,15 +230,33 @@ impl RestedCounts {
     pub fn add(&mut self, o: RestedCounts) {
         self.isolated_ok += o.isolated_ok;
         self.handling_loud += o.handling_loud;
+        self.seq.0 += o.seq.0;
+        self.seq.1 += o.seq.1;
+        self.seq.2 += o.seq.2;
+    }
+
+    /// Sequence F1 from [`Self::seq`], 0 when nothing matched.
+    pub fn seq_f1(&self) -> f64 {
+        let (matched, events, labels) = self.seq;
+        let (p, r) = (
+            matched as f64 / events.max(1) as f64,
+            matched as f64 / labels.max(1) as f64,
+        );
+        if p + r > 0.0 {
+            2.0 * p * r / (p + r)
+        } else {
+            0.0
+        }
     }
 
     /// These counts in words, out of `isolated` gestures and `handling` logs.
     pub fn words(&self, isolated: usize, handling: usize) -> String {
         format!(
             "left resting {RESTED_S} s after each log: isolated {} of {isolated} read as \
-             played, handling silent on {} of {handling} logs",
+             played, handling silent on {} of {handling} logs, sequence F1 {:.1}%",
             self.isolated_ok,
-            handling - self.handling_loud.min(handling)
+            handling - self.handling_loud.min(handling),
+            100.0 * self.seq_f1()
         )
     }
 }
@@ -502,6 +523,10 @@ pub fn evaluate(
         let evs = run_doodle(&d, &names, &blob, effort)?;
         n_ev += evs.len();
         n_lab += d.labels.len();
+        let at_rest = run_doodle(&rested(&d), &names, &blob, effort)?;
+        f.rested.seq.0 += pair_events(&d.labels, &at_rest).iter().flatten().count();
+        f.rested.seq.1 += at_rest.len();
+        f.rested.seq.2 += d.labels.len();
         if args.verbose && k < 3 {
             for l in &d.labels {
                 eprintln!("  label {:<9} {:7.2} {:7.2}", l.action, l.start, l.end);

@@ -83,7 +83,7 @@ pub struct Tally {
     pub talk: TalkCounts,
     /// Isolated gestures by (action played, read as or "none"), read as another.
     pub misreads: BTreeMap<(String, String), usize>,
-    /// The same isolated gestures and handling logs, each followed by stillness.
+    /// The same isolated gestures, handling logs and sequences, each followed by stillness.
     pub rested: RestedCounts,
 }
 
@@ -315,6 +315,7 @@ mod tests {
             rested: RestedCounts {
                 isolated_ok: ok + 9,
                 handling_loud: loud + 1,
+                seq: (9, 10, 12),
             },
             ..Figures::default()
         };
@@ -337,7 +338,8 @@ mod tests {
             "counts over the pairs: isolated 37 of 40 read as played, of them Time right 35, \
              Weight 33, both 31; handling silent on 33 of 40 logs; held in a hand that talks, \
              6 events in 3.0 minutes, 120 per hour; left resting 3 s after each log: \
-             isolated 35 of 40 read as played, handling silent on 31 of 40 logs"
+             isolated 35 of 40 read as played, handling silent on 31 of 40 logs, sequence F1 \
+             81.8%"
         );
         assert_eq!(
             t.misreads_line().as_deref(),
