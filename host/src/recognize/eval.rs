@@ -16,9 +16,10 @@
 //!   and the actions they were read as;
 //! - decision latency: when the event was emitted, after the performance's labelled end
 //!   (median and 90th percentile);
-//! - the isolated gestures, handling logs and sequences read again, each followed by [`RESTED_S`] of
-//!   stillness ([`Figures::rested`]): a log is read to its end, 0.3–1.5 s after its motion,
-//!   and the stream's end decides some phrases otherwise than a figurine left resting does.
+//! - the isolated gestures, handling logs and sequences read again, each followed by
+//!   [`RESTED_S`] of stillness ([`Figures::rested`]): a log is read to its end, 0.3–1.5 s
+//!   after its motion, and the stream's end decides some phrases otherwise than a figurine
+//!   left resting does.
 //!
 //! The benchmarks (`figurine eval rest | sweep | real | repeat`) are dispatched by
 //! [`super::eval_cli`], each in its own module; they use what is here.
@@ -208,9 +209,8 @@ pub struct Figures {
 }
 
 /// Stillness appended to each isolated gesture, handling log and sequence for
-/// [`Figures::rested`], s:
-/// longer than any hold a decision waits for and than the 2.5 s after which partial matches
-/// are forgotten, so nothing is left for the stream's end to decide.
+/// [`Figures::rested`], s: longer than any hold a decision waits for and than the 2.5 s after
+/// which partial matches are forgotten, so nothing is left for the stream's end to decide.
 pub const RESTED_S: f64 = 3.0;
 
 /// [`Figures::rested`]: isolated gestures read as played, handling logs with any event and
