@@ -34,7 +34,7 @@ use super::effort_train::{gesture_features, train, Example, Trained};
 use super::learn::learn_action;
 use super::library::LibraryFile;
 use super::scoring::{
-    label_ok, notes_of, overlap, pair_events, run_doodle, Ev, ExtraEvents, ExtraKind,
+    label_ok, notes_of, overlap, pair_events, prf, run_doodle, Ev, ExtraEvents, ExtraKind,
 };
 use super::simulate::load_effort;
 use crate::synth::sequence::{Doodle, Label};
@@ -238,15 +238,7 @@ impl RestedCounts {
     /// Sequence F1 from [`Self::seq`], 0 when nothing matched.
     pub fn seq_f1(&self) -> f64 {
         let (matched, events, labels) = self.seq;
-        let (p, r) = (
-            matched as f64 / events.max(1) as f64,
-            matched as f64 / labels.max(1) as f64,
-        );
-        if p + r > 0.0 {
-            2.0 * p * r / (p + r)
-        } else {
-            0.0
-        }
+        prf(matched, events, labels).2
     }
 
     /// These counts in words, out of `isolated` gestures and `handling` logs.
@@ -589,17 +581,7 @@ pub fn evaluate(
             }
         }
     }
-    let p = matched as f64 / n_ev.max(1) as f64;
-    let r = matched as f64 / n_lab.max(1) as f64;
-    f.seq_prf = (
-        p,
-        r,
-        if p + r > 0.0 {
-            2.0 * p * r / (p + r)
-        } else {
-            0.0
-        },
-    );
+    f.seq_prf = prf(matched, n_ev, n_lab);
     Ok(f)
 }
 

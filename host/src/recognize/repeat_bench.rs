@@ -16,7 +16,7 @@ use clap::Args;
 use rayon::prelude::*;
 
 use super::eval::{learn_synth_library, rested, RESTED_S};
-use super::scoring::{pair_events, run_doodle, Ev};
+use super::scoring::{pair_events, prf, run_doodle, Ev};
 use super::simulate::load_effort;
 use crate::synth::{self, Action, Knobs, Label, Range};
 
@@ -63,6 +63,14 @@ struct Outcome {
 }
 
 impl Outcome {
+    /// Adds another doodle's counts.
+    fn add(&mut self, o: &Outcome) {
+        self.due += o.due;
+        self.of_action += o.of_action;
+        self.other += o.other;
+        self.matched += o.matched;
+    }
+
     fn exact(&self) -> bool {
         self.of_action == self.due && self.other == 0 && self.matched == self.due
     }
@@ -98,19 +106,10 @@ fn scores<'a>(outcomes: impl Iterator<Item = (Action, &'a Outcome)>) -> [f64; 6]
         let k = &mut by_kind[usize::from(action.continues())];
         k.0 += usize::from(o.exact());
         k.1 += 1;
-        all.due += o.due;
-        all.of_action += o.of_action;
-        all.other += o.other;
-        all.matched += o.matched;
+        all.add(o);
     }
     let share = |a: usize, b: usize| a as f64 / b.max(1) as f64;
-    let p = share(all.matched, all.of_action + all.other);
-    let r = share(all.matched, all.due);
-    let f1 = if p + r > 0.0 {
-        2.0 * p * r / (p + r)
-    } else {
-        0.0
-    };
+    let (p, r, f1) = prf(all.matched, all.of_action + all.other, all.due);
     let [one, on] = by_kind;
     [
         share(one.0 + on.0, one.1 + on.1),
@@ -207,12 +206,8 @@ pub fn run(args: &RepeatArgs) -> Result<()> {
         let os: Vec<&Outcome> = pairs.iter().flat_map(|p| &p[ai]).map(|o| &o.0).collect();
         let n = os.len();
         let ex = os.iter().filter(|o| o.exact()).count();
-        let sum = os.iter().fold(Outcome::default(), |a, o| Outcome {
-            due: a.due + o.due,
-            of_action: a.of_action + o.of_action,
-            other: a.other + o.other,
-            matched: a.matched + o.matched,
-        });
+        let mut sum = Outcome::default();
+        os.iter().for_each(|o| sum.add(o));
         println!(
             "{:<10} {:<10} {:>6.0}% {:>7.2} of {:<6.2} {:>8}",
             action.name(),

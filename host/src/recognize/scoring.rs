@@ -139,6 +139,19 @@ impl ExtraEvents {
     }
 }
 
+/// Precision, recall and F1 of `matched` labels out of `events` reported and `labels` due
+/// (a share of nothing is 0).
+pub fn prf(matched: usize, events: usize, labels: usize) -> (f64, f64, f64) {
+    let p = matched as f64 / events.max(1) as f64;
+    let r = matched as f64 / labels.max(1) as f64;
+    let f1 = if p + r > 0.0 {
+        2.0 * p * r / (p + r)
+    } else {
+        0.0
+    };
+    (p, r, f1)
+}
+
 /// For each label in order, the event it is matched to: the not yet matched event of its
 /// action that overlaps it most (none if no event of its action overlaps it).
 pub fn pair_events(labels: &[Label], evs: &[Ev]) -> Vec<Option<usize>> {
