@@ -10,7 +10,9 @@
 //! every example rose, a punch thrown without its wind-up. A child expects the toy to answer
 //! it. Such a phrase is compared whole with every action ([`weighted_cost`]) and reported as
 //! the nearest one when it is within the share of edits every match is held to
-//! ([`EDIT_SHARE`]), without the action's own bound — or as the nearest action within the
+//! ([`EDIT_SHARE`]), without the action's own bound, and did not move plainly unlike that
+//! action's examples ([`SHAPE_CAP`]: a talking hand's beat spells a stroke or two of some
+//! pattern, but not the way its examples moved) — or as the nearest action within the
 //! looser [`PHRASE_SHARE`] whose examples moved as the phrase did (its
 //! [`crate::features::Shape`]: a lone sidestep hop, one stroke short of every example);
 //! otherwise nothing is reported.
@@ -156,16 +158,22 @@ pub fn nearest_action(
             open: true,
         });
     }
-    // The nearest action within the share every match is held to; and within the looser
-    // phrase share, the nearest of those whose examples moved as the phrase did (a sudden
-    // sidestep's lone hop). One alignment per action, bounded by the share it can use: the
-    // shape is checked first, and most actions fail it.
+    // The nearest action within the share every match is held to, of those whose examples
+    // the phrase did not move plainly unlike (a hand that talks beats out a stroke or two
+    // that some pattern spells, but not the way that action's examples moved); and within the
+    // looser phrase share, the nearest of those whose examples moved as the phrase did (a
+    // sudden sidestep's lone hop). One alignment per action, bounded by the share it can use:
+    // the shape is checked first, and most actions fail it.
     let mut best: Option<(Candidate, usize)> = None;
     let mut alike: Option<(Candidate, usize)> = None;
     let observed = observed_shape(hist, first, last);
     let (e, t) = EDIT_SHARE;
     for a in 0..lib.len() {
-        let moved_alike = penalty_of(lib, a, &observed) == Some(0);
+        let penalty = penalty_of(lib, a, &observed);
+        if penalty == Some(SHAPE_CAP) {
+            continue;
+        }
+        let moved_alike = penalty == Some(0);
         let share = if moved_alike {
             PHRASE_SHARE
         } else {
@@ -594,6 +602,32 @@ mod tests {
             .candidate,
             None
         );
+    }
+
+    #[test]
+    fn a_stand_alone_gesture_moved_plainly_unlike_its_nearest_action_is_none() {
+        // A punch without its wind-up (`f b`, one deletion in three aligned tokens), thrust
+        // forward and drawn back: its speed along the front axis (|v| per axis).
+        let (h, thrust) = moved(&[
+            ("f", 20, [0.0, 0.05, 0.9], 0.0),
+            ("b", 20, [0.0, 0.05, 0.9], 0.0),
+        ]);
+        let mut bobbed = thrust;
+        (bobbed[1], bobbed[2]) = (thrust[2], thrust[1]);
+        let blob = lib_blob();
+        let read = |punch: Option<[u8; 6]>| {
+            let shaped = crate::pattern::tests::with_shapes(&blob, &[punch, None, None]);
+            let lib = Library::from_bytes(&shaped).unwrap();
+            let penalty = penalty_of(&lib, 0, &observed_shape(&h, 1, 2));
+            let found = nearest_action(&lib, &h, 0, false, 2, false).unwrap();
+            (penalty, found.candidate.map(|c| c.action))
+        };
+        // Its examples thrust forward too, or left no shape: the punch.
+        assert_eq!(read(Some(shape_bytes(thrust))), (Some(0), Some(0)));
+        assert_eq!(read(None), (None, Some(0)));
+        // Its examples bobbed up and down: the strokes spell a punch, the motion does not (a
+        // hand that talks beats out such strokes).
+        assert_eq!(read(Some(shape_bytes(bobbed))), (Some(SHAPE_CAP), None));
     }
 
     #[test]
