@@ -6,7 +6,7 @@
 //! | quorum | a variation is kept when [`quorum`] strings show it: any one of three to six examples and their average, a quarter of more (one odd performance among many no longer widens the pattern) |
 //! | columns | the mandatory strings are aligned to the reference's (the one with the fewest mandatory runs, the quorum-th fewest) by edit distance; column i becomes `(m_i0\|…\|m_in)+` of the tokens a quorum showed there, or `…*` when most strings lack it or a quorum of performances too short for an edit do; a stroke that turned as it moved is written with its plain stroke too (`db.Xn\|db`, [`with_plain`]: the turn may fall under the token threshold in another performance) |
 //! | optional runs | the optional tokens a quorum showed between two columns become `(o_1\|…\|o_k)*` before the later column — or mandatory columns when every example has the same optional sequence there |
-//! | repetition | a cyclic action's whole pattern repeats (cyclic: the reference repeats a cycle, or a quorum of performances is closer to it done twice, or two near-copies of one part); a pattern needs two tokens at least: when its only mandatory column is a part every example performs twice or more (a run's strides), that column is written twice |
+//! | repetition | a cyclic action's whole pattern repeats (cyclic: the reference repeats a cycle, or a quorum of performances is closer to it done twice, or repeats one part — all its strokes but a third are the stroke a period later, [`REPEAT_OFF_PER`]); a pattern needs two tokens at least: when its only mandatory column is a part every example performs twice or more (a run's strides), that column is written twice |
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -73,6 +73,19 @@ pub fn quorum(strings: usize) -> usize {
 
 /// Mandatory columns a learnt pattern keeps at least (when its reference has that many).
 pub const MIN_MANDATORY: usize = 1;
+
+/// A performance repeats one part (the action is cyclic) when all its strokes but one in this
+/// many are the stroke one period later: a walk's strides, each a little different, repeat;
+/// a kick's thrust and return (`b f b db`: half its strokes differ a period on) do not.
+pub const REPEAT_OFF_PER: usize = 3;
+
+/// Mandatory strokes a performance needs for that test: three, so that a stroke and its
+/// return are no cycle.
+pub const REPEAT_MANDATORY: usize = 3;
+
+/// Strokes of all kinds (consecutive ones alike by translation counted once) a performance
+/// needs for that test on all its strokes: two periods of three.
+pub const REPEAT_STROKES: usize = 6;
 
 /// Distinct tokens sharing one half that make the other half a wildcard.
 pub const WILDCARD_VARIANTS: usize = 3;
@@ -265,11 +278,21 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize, quorum: usize) -> R
     };
     let periodic =
         (2..=once.len() / 2).any(|p| (0..once.len() - p).all(|i| key(once[i]) == key(once[i + p])));
-    // … or when a quorum of performances is two near-copies of one part (by translation):
-    // each one's halves differ by at most one run.
-    let halves = |s: &Tokenized| {
-        let m: Vec<Token> = mand_of(s).into_iter().map(key).collect();
-        m.len() >= 4 && (2..=m.len() - 2).any(|p| edit_distance(&m[..p], &m[p..]) <= 1)
+    // … or when a quorum of performances repeat one part (by translation): all but a third of
+    // the strokes are the stroke one period later, over enough of its mandatory strokes, or of
+    // all its strokes (a long performance whose every stride is too brief to be mandatory).
+    let repeats = |m: &[Token]| {
+        (1..=m.len() / 2).any(|p| {
+            let off = (0..m.len() - p).filter(|&i| m[i] != m[i + p]).count();
+            REPEAT_OFF_PER * off <= m.len() - p
+        })
+    };
+    let repeats_a_part = |s: &Tokenized| {
+        let mand: Vec<Token> = mand_of(s).into_iter().map(key).collect();
+        let mut all: Vec<Token> = s.iter().map(|&(t, _)| key(t & 0x3ff)).collect();
+        all.dedup();
+        (mand.len() >= REPEAT_MANDATORY && repeats(&mand))
+            || (all.len() >= REPEAT_STROKES && repeats(&all))
     };
     let cyclic = periodic
         || seqs
@@ -280,7 +303,7 @@ pub fn learn_regex_within(seqs: &[Tokenized], budget: usize, quorum: usize) -> R
             })
             .count()
             >= q
-        || seqs.iter().filter(|s| halves(s)).count() >= q;
+        || seqs.iter().filter(|s| repeats_a_part(s)).count() >= q;
     // A cyclic action rocks one way and back from cycle to cycle: which way a stroke wobbled
     // is no part of it. (A one-shot gesture's small turn keeps its sign: a throw's follow-through
     // dips forward, whatever else varies.)
@@ -671,9 +694,10 @@ mod tests {
     }
 
     #[test]
-    fn a_performance_made_of_two_near_copies_makes_the_action_cyclic() {
+    fn a_performance_repeating_a_part_makes_the_action_cyclic() {
         // Every example already holds two hops, each a little differently: no exact period,
-        // and none is closer to the reference done twice — but each is two near-copies.
+        // and none is closer to the reference done twice — but in two of them every stroke
+        // but one in three is the stroke a hop later.
         let seqs = vec![
             seq("uf:0.3 df:0.3 f:0.3 uf:0.3 df:0.3"),
             seq("uf:0.3 df:0.3 uf:0.3 df:0.3 f:0.3"),
@@ -681,10 +705,36 @@ mod tests {
         ];
         let re = learn_regex(&seqs).unwrap();
         assert!(re.compile().unwrap().cyclic, "{}", re.to_source());
-        // A back-and-forth stroke is no cycle: three runs cannot hold two copies.
+        // A back-and-forth stroke is no cycle: no stroke comes back a period later.
         let seqs = vec![seq("b:0.3 f:0.3 b:0.3"), seq("b:0.3 f:0.3 b:0.3")];
         let re = learn_regex(&seqs).unwrap();
         assert!(!re.compile().unwrap().cyclic, "{}", re.to_source());
+    }
+
+    #[test]
+    fn a_thrust_and_its_return_is_no_cycle() {
+        // Kicks: a wind-up, the thrust, its return and a settling step back. Each string's
+        // halves (`b f` and `b db`) differ by one stroke, but every second stroke does not
+        // come back a period later: one kick, not two.
+        let seqs = vec![
+            seq("b:0.15 f.Xn:0.3 b.Xp:0.3 db:0.15"),
+            seq("b:0.15 f.Xn:0.25 b.Xp:0.35 db.Xp:0.15"),
+            seq("b:0.12 uf.Xn:0.3 b.Xp:0.3 db.Xp:0.2"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(!re.compile().unwrap().cyclic, "{}", re.to_source());
+    }
+
+    #[test]
+    fn strides_too_brief_to_be_mandatory_still_make_a_cycle() {
+        // A walk taught with one long stride, then three brief ones: only the long stride's
+        // runs are mandatory, but all its strokes repeat `uf df` with one in three off.
+        let seqs = vec![
+            seq("uf:0.6 df:0.6 f:0.04 uf:0.04 df:0.04 uf:0.04 df:0.04 uf:0.04 df:0.04"),
+            seq("uf:0.5 df:0.7 uf:0.04 df:0.04 uf:0.04 df:0.05 uf:0.04 df:0.04"),
+        ];
+        let re = learn_regex(&seqs).unwrap();
+        assert!(re.compile().unwrap().cyclic, "{}", re.to_source());
     }
 
     #[test]
