@@ -719,8 +719,8 @@ mod tests {
     #[test]
     fn a_thrust_and_its_return_is_no_cycle() {
         // Kicks: a wind-up, the thrust, its return and a settling step back. Each string's
-        // halves (`b f` and `b db`) differ by one stroke, but every second stroke does not
-        // come back a period later: one kick, not two.
+        // halves (`b f` and `b db`) differ by one stroke, but half its strokes do not come
+        // back a period later: one kick, not two.
         assert!(!cyclic(&[
             "b:0.15 f.Xn:0.3 b.Xp:0.3 db:0.15",
             "b:0.15 f.Xn:0.25 b.Xp:0.35 db.Xp:0.15",
@@ -730,8 +730,8 @@ mod tests {
 
     #[test]
     fn strides_too_brief_to_be_mandatory_still_make_a_cycle() {
-        // A walk taught with one long stride, then three brief ones: only the long stride's
-        // runs are mandatory, but all its strokes repeat `uf df` with one in three off.
+        // A walk taught with one long stride, then brief ones: only the long stride's runs
+        // are mandatory, but all its strokes repeat `uf df`, fewer than one in three off.
         assert!(cyclic(&[
             "uf:0.6 df:0.6 f:0.04 uf:0.04 df:0.04 uf:0.04 df:0.04 uf:0.04 df:0.04",
             "uf:0.5 df:0.7 uf:0.04 df:0.04 uf:0.04 df:0.05 uf:0.04 df:0.04",
