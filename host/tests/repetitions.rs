@@ -71,21 +71,12 @@ fn a_walk_played_on_stays_one_walk() {
 /// How many of the libraries learnt at train seeds `seeds` (three generated examples, as
 /// `figurine eval` learns them) write `action` as a cyclic pattern: one whose whole repeats.
 fn learnt_cyclic(action: Action, seeds: std::ops::Range<u64>) -> usize {
+    use figurine_host::recognize::eval::synth_examples;
     use figurine_host::recognize::learn::learn_action;
     use figurine_host::recognize::regex::Regex;
-    let index = Action::ALL.iter().position(|&a| a == action).unwrap() as u64;
     seeds
         .filter(|&seed| {
-            let logs: Vec<_> = synth::sequence::examples(
-                synth::sequence::item_seed(seed, 100 + index),
-                &Knobs::default(),
-                action,
-                3,
-                None,
-            )
-            .into_iter()
-            .map(|d| d.log)
-            .collect();
+            let logs = synth_examples(seed, 3, &Knobs::default(), action);
             let entry = learn_action(action.name(), &logs, None, true).unwrap();
             Regex::parse(&entry.regex)
                 .unwrap()

@@ -134,18 +134,31 @@ impl EvalArgs {
     }
 }
 
+/// The `n` generated examples of `action` that [`learn_synth_library`] learns it from.
+pub fn synth_examples(
+    seed: u64,
+    n: usize,
+    knobs: &Knobs,
+    action: Action,
+) -> Vec<crate::poselog::PoseLog> {
+    let index = Action::ALL.iter().position(|&a| a == action).unwrap_or(0) as u64;
+    synth::examples(
+        synth::sequence::item_seed(seed, 100 + index),
+        knobs,
+        action,
+        n,
+        None,
+    )
+    .into_iter()
+    .map(|d| d.log)
+    .collect()
+}
+
 /// Learns every synth action from `n` generated examples.
 pub fn learn_synth_library(seed: u64, n: usize, knobs: &Knobs) -> Result<LibraryFile> {
     let mut lib = LibraryFile::default();
-    for (i, &action) in Action::ALL.iter().enumerate() {
-        let docs = synth::examples(
-            synth::sequence::item_seed(seed, 100 + i as u64),
-            knobs,
-            action,
-            n,
-            None,
-        );
-        let logs: Vec<_> = docs.into_iter().map(|d| d.log).collect();
+    for &action in Action::ALL.iter() {
+        let logs = synth_examples(seed, n, knobs, action);
         lib.upsert(learn_action(action.name(), &logs, None, true)?);
     }
     for step in super::separate::separate(&mut lib)? {
