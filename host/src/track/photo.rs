@@ -25,7 +25,7 @@
 use glam::{DQuat, DVec3};
 
 use super::detect::{CameraPose, GrayFrame, Intrinsics, TagPattern};
-use super::pnp::{least_squares, Search};
+use super::pnp::solve_linear;
 
 /// Least angle between the two poses, degrees, for the picture to judge them (see the module
 /// text).
@@ -37,15 +37,6 @@ pub const SAMPLES: usize = 3;
 pub const RAMP_CELLS: f64 = 0.35;
 /// Levenberg–Marquardt steps per pose.
 pub const STEPS: usize = 5;
-/// How a pose is refined on the picture: [`STEPS`] steps, a fiftieth of a degree and of a
-/// millimetre for the Jacobian (the drawing is smooth over a few tenths of a pixel).
-const PICTURE_SEARCH: Search = Search {
-    steps: STEPS,
-    tries: 6,
-    damping: (1e-2, 1e-6),
-    h: (2e-4, 2e-5),
-    min_gain: 0.0,
-};
 /// Fewest pixels on the tag for a verdict.
 const MIN_PIXELS: usize = 16;
 /// Most rays drawn for one look at the tag: a nearer, larger tag is drawn with fewer rays a
@@ -217,18 +208,70 @@ impl<'a> Problem<'a> {
         )
     }
 
-    /// The pose near (q, t) the picture fits best (step 4).
-    fn refine(&self, q: DQuat, t: DVec3) -> Option<(DQuat, DVec3)> {
-        let fit = least_squares(
-            q,
-            t,
-            &PICTURE_SEARCH,
-            |q, t| self.residuals(q, t),
-            sum_sq,
-            |_| true,
-        )?;
-        Some((fit.0, fit.1))
+    /// Levenberg–Marquardt on the misfit from (q, t): a rotation-vector step on the left and
+    /// the translation, a numerical Jacobian (step 4).
+    fn refine(&self, mut q: DQuat, mut t: DVec3) -> Option<(DQuat, DVec3)> {
+        let mut r = self.residuals(q, t)?;
+        let mut cost = sum_sq(&r);
+        let mut mu = 1e-2;
+        for _ in 0..STEPS {
+            let mut jac: [Vec<f64>; 6] = Default::default();
+            for (j, col) in jac.iter_mut().enumerate() {
+                // A fiftieth of a degree, a fiftieth of a millimetre.
+                let h = if j < 3 { 2e-4 } else { 2e-5 };
+                let mut d = [0.0; 6];
+                d[j] = h;
+                let (q1, t1) = step(q, t, &d);
+                let r1 = self.residuals(q1, t1)?;
+                *col = r1.iter().zip(&r).map(|(a, b)| (a - b) / h).collect();
+            }
+            let mut jtj = [[0.0; 6]; 6];
+            let mut jtr = [0.0; 6];
+            for a in 0..6 {
+                for b in 0..6 {
+                    jtj[a][b] = jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum();
+                }
+                jtr[a] = -jac[a].iter().zip(&r).map(|(x, y)| x * y).sum::<f64>();
+            }
+            let mut improved = false;
+            for _ in 0..6 {
+                let mut damped = jtj;
+                for (a, row) in damped.iter_mut().enumerate() {
+                    row[a] += mu * jtj[a][a].max(1e-9);
+                }
+                let Some(d) = solve_linear(damped, jtr) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let (q1, t1) = step(q, t, &d);
+                match self.residuals(q1, t1) {
+                    Some(r1) if sum_sq(&r1) < cost => {
+                        cost = sum_sq(&r1);
+                        (q, t, r) = (q1, t1, r1);
+                        mu = (mu * 0.3).max(1e-6);
+                        improved = true;
+                        break;
+                    }
+                    _ => mu *= 10.0,
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        Some((q, t))
     }
+}
+
+/// Pose (q, t) moved by a rotation vector `d[0..3]` (on the left) and a translation `d[3..6]`.
+fn step(q: DQuat, t: DVec3, d: &[f64; 6]) -> (DQuat, DVec3) {
+    let w = DVec3::new(d[0], d[1], d[2]);
+    let turn = if w.length() > 0.0 {
+        DQuat::from_scaled_axis(w)
+    } else {
+        DQuat::IDENTITY
+    };
+    ((turn * q).normalize(), t + DVec3::new(d[3], d[4], d[5]))
 }
 
 /// Where the ray through pixel (x, y) meets the plane of the tag at pose (q, t), in the tag's
