@@ -120,46 +120,21 @@ pub struct Search {
     pub tries: usize,
     /// Damping at the start, and the least it falls to (×0.3 after each step taken).
     pub damping: (f64, f64),
+    /// Finite-difference step of the rotation (radians) and of the translation (metres).
+    pub h: (f64, f64),
     /// Least fall in cost for a step to count as progress: below it the search stops.
     pub min_gain: f64,
 }
 
-/// The residuals' derivatives by each of a pose's six parameters — a rotation vector on the
-/// left (radians), then the translation (metres) — one column each.
-pub type Jacobian = [Vec<f64>; 6];
-
-/// [`Jacobian`] by forward differences from the residuals `r` at (q, t): steps of `h.0`
-/// radians and `h.1` metres. `None` when a stepped pose has no residuals.
-pub fn numerical_jacobian(
-    residuals: &impl Fn(DQuat, DVec3) -> Option<Vec<f64>>,
-    q: DQuat,
-    t: DVec3,
-    r: &[f64],
-    h: (f64, f64),
-) -> Option<Jacobian> {
-    let mut jac: Jacobian = Default::default();
-    for (j, col) in jac.iter_mut().enumerate() {
-        let h = if j < 3 { h.0 } else { h.1 };
-        let mut d = [0.0; 6];
-        d[j] = h;
-        let (q1, t1) = step(q, t, &d);
-        let r1 = residuals(q1, t1)?;
-        *col = r1.iter().zip(r).map(|(a, b)| (a - b) / h).collect();
-    }
-    Some(jac)
-}
-
-/// Levenberg–Marquardt on a pose — a rotation-vector step on the left, and the translation:
-/// lowers `cost` of the `residuals` a pose gives, the `jacobian` of them at a pose (given its
-/// residuals) guiding each step, taking a step only where they exist, the cost falls and
-/// `accept` takes the new translation. Returns the pose and its residuals; `None` when the
-/// start or a Jacobian cannot be had.
+/// Levenberg–Marquardt on a pose — a rotation-vector step on the left, and the translation —
+/// with a numerical Jacobian: lowers `cost` of the `residuals` a pose gives, taking a step only
+/// where they exist, the cost falls and `accept` takes the new translation. Returns the pose
+/// and its residuals; `None` when a pose the Jacobian needs has no residuals.
 pub fn least_squares(
     mut q: DQuat,
     mut t: DVec3,
     search: &Search,
     residuals: impl Fn(DQuat, DVec3) -> Option<Vec<f64>>,
-    jacobian: impl Fn(DQuat, DVec3, &[f64]) -> Option<Jacobian>,
     cost_of: impl Fn(&[f64]) -> f64,
     accept: impl Fn(DVec3) -> bool,
 ) -> Option<(DQuat, DVec3, Vec<f64>)> {
@@ -167,7 +142,15 @@ pub fn least_squares(
     let mut cost = cost_of(&r);
     let mut mu = search.damping.0;
     for _ in 0..search.steps {
-        let jac = jacobian(q, t, &r)?;
+        let mut jac: [Vec<f64>; 6] = Default::default();
+        for (j, col) in jac.iter_mut().enumerate() {
+            let h = if j < 3 { search.h.0 } else { search.h.1 };
+            let mut d = [0.0; 6];
+            d[j] = h;
+            let (q1, t1) = step(q, t, &d);
+            let r1 = residuals(q1, t1)?;
+            *col = r1.iter().zip(&r).map(|(a, b)| (a - b) / h).collect();
+        }
         let mut jtj = [[0.0; 6]; 6];
         let mut jtr = [0.0; 6];
         for a in 0..6 {
@@ -221,10 +204,9 @@ const CORNER_SEARCH: Search = Search {
     steps: 30,
     tries: 8,
     damping: (1e-3, 1e-9),
+    h: (1e-6, 1e-7),
     min_gain: 1e-9,
 };
-/// Forward-difference steps of [`refine`]'s Jacobian: a microradian, a tenth of a micrometre.
-const CORNER_H: (f64, f64) = (1e-6, 1e-7);
 
 /// Levenberg–Marquardt on a pose that takes object points `obj` (metres) to pixels `px`
 /// ([`least_squares`] on the reprojection error); returns the refined pose and its RMS point
@@ -237,13 +219,11 @@ pub fn refine(
     px: &[DVec2],
     k: &Intrinsics,
 ) -> (DQuat, DVec3, f64) {
-    let misfit = |q, t| Some(residuals(q, t, obj, px, k));
     let fit = least_squares(
         q,
         t,
         &CORNER_SEARCH,
-        misfit,
-        |q, t, r: &[f64]| numerical_jacobian(&misfit, q, t, r, CORNER_H),
+        |q, t| Some(residuals(q, t, obj, px, k)),
         rms,
         |t| t.z > 0.0,
     );
