@@ -53,7 +53,7 @@ fn a_gesture_is_tracked_within_goals_and_reads_as_the_same_action() {
 }
 
 #[test]
-fn searching_near_the_tag_first_finds_the_same_poses_in_a_fraction_of_the_time() {
+fn searching_near_the_tag_first_finds_the_same_poses_in_a_fraction_of_the_pixels() {
     let dir = scratch("region");
     std::fs::write(dir.join("keep"), b"").unwrap();
     let setup = Setup {
@@ -88,17 +88,19 @@ fn searching_near_the_tag_first_finds_the_same_poses_in_a_fraction_of_the_time()
         (sa.ori_median_deg - sb.ori_median_deg).abs() < 0.5,
         "{sa:?} vs {sb:?}"
     );
-    let median = |v: &[f64]| {
+    // The work saved, counted rather than timed (the time, release-built, is the track
+    // bench's "frame → sample" figure, against `--whole-frames`): the median frame is searched
+    // in a region a few tag widths across, not a whole frame.
+    let median = |v: &[usize]| {
         let mut v = v.to_vec();
-        v.sort_by(f64::total_cmp);
+        v.sort_unstable();
         v[v.len() / 2]
     };
-    let (ta, tb) = (median(&a.latency_s), median(&b.latency_s));
+    let (pa, pb) = (median(&a.searched_px), median(&b.searched_px));
+    assert_eq!(pa, 640 * 480, "the whole frame, every frame");
     assert!(
-        tb * 4.0 < ta,
-        "median {:.2} ms near the tag, {:.2} ms whole",
-        tb * 1e3,
-        ta * 1e3
+        pb * 20 < pa,
+        "median {pb} pixels searched near the tag, {pa} whole"
     );
 }
 

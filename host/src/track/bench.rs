@@ -110,6 +110,8 @@ pub struct GestureRun {
     pub gapped_actions: Vec<String>,
     /// Tracking time per frame (detection and pose), seconds.
     pub latency_s: Vec<f64>,
+    /// Pixels the detector searched per frame.
+    pub searched_px: Vec<usize>,
 }
 
 /// Renders, tracks and compares one gesture; files go in `dir`.
@@ -164,6 +166,7 @@ pub fn run_gesture(
         tracked_actions,
         gapped_actions,
         latency_s: run.latency_s,
+        searched_px: run.searched_px,
     })
 }
 
@@ -348,11 +351,17 @@ pub fn report(runs: &[GestureRun]) -> String {
     }
     let mut lat: Vec<f64> = runs.iter().flat_map(|r| r.latency_s.clone()).collect();
     let (med, p95) = (quantile(&mut lat, 0.5), quantile(&mut lat, 0.95));
+    let mut px: Vec<f64> = runs
+        .iter()
+        .flat_map(|r| r.searched_px.iter().map(|&p| p as f64))
+        .collect();
     let _ = writeln!(
         out,
-        "\nframe → sample (detection and pose, 640×480): median {:.1} ms, p95 {:.1} ms",
+        "\nframe → sample (detection and pose, 640×480): median {:.1} ms, p95 {:.1} ms; \
+         pixels searched per frame, median {:.0}",
         med * 1000.0,
-        p95 * 1000.0
+        p95 * 1000.0,
+        quantile(&mut px, 0.5)
     );
     let _ = writeln!(out, "\ntracked jitter at rest (σ):");
     for (lo, hi) in [(0.2, 0.65), (0.65, 0.9), (0.9, 1.5)] {
@@ -502,6 +511,7 @@ mod tests {
             tracked_actions: names(tracked),
             gapped_actions: names(gapped),
             latency_s: vec![0.001],
+            searched_px: vec![5_000],
         }
     }
 

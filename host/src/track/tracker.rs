@@ -12,7 +12,7 @@
 
 use glam::{DQuat, DVec3};
 
-use super::detect::{CameraPose, Detection, Detector, GrayFrame, Intrinsics, Region};
+use super::detect::{CameraPose, Detection, Detector, GrayFrame, Intrinsics, Region, ENLARGE};
 use super::fuse::{fuse, solve_tags, Fused};
 use super::mirror::MirrorChooser;
 use super::pose::{figurine_pose, project};
@@ -93,6 +93,9 @@ pub struct FrameResult {
     pub pose: Option<super::detect::CameraPose>,
     /// The region searched first, near the tag's last place (`None`: the whole frame only).
     pub region: Option<Region>,
+    /// Pixels the detector searched for this frame, over every try (a region searched
+    /// enlarged counts its enlarged pixels): the work the region search saves.
+    pub searched_px: usize,
 }
 
 impl Tracker {
@@ -167,19 +170,23 @@ impl Tracker {
     /// Processes the frame taken at `t` seconds.
     pub fn frame(&mut self, t: f64, frame: &GrayFrame) -> FrameResult {
         let near = self.search_region(t, frame);
+        let mut searched = near.map_or(0, |r| r.area());
         let mut found = near
             .map(|r| clearest(&self.rig, self.detector.detect_in(frame, r)))
             .unwrap_or_default();
         let small = self.seen.as_ref().is_some_and(|s| s.side < SMALL_TAG_PX);
         if let Some(r) = near.filter(|_| found.is_empty() && small) {
+            searched += r.area() * ENLARGE * ENLARGE;
             found = clearest(&self.rig, self.detector.detect_in_enlarged(frame, r));
         }
         if found.is_empty() {
             if let Some((r, blur)) = self.blur_region(t, frame) {
+                searched += r.area();
                 found = clearest(&self.rig, self.detector.detect_in_deblurred(frame, r, blur));
             }
         }
         if found.is_empty() {
+            searched += frame.width * frame.height;
             found = clearest(&self.rig, self.detector.detect(frame));
         }
         let k = self.intrinsics;
@@ -226,6 +233,7 @@ impl Tracker {
             detections: found,
             pose: fused.or_else(|| largest.map(|s| s.body)),
             region: near,
+            searched_px: searched,
         }
     }
 
@@ -359,6 +367,8 @@ pub struct TrackRun {
     /// Per frame, the time from the decoded frame to its sample (detection and pose),
     /// seconds.
     pub latency_s: Vec<f64>,
+    /// Per frame, the pixels the detector searched ([`FrameResult::searched_px`]).
+    pub searched_px: Vec<usize>,
 }
 
 /// Tracks every frame of `reader`, handing each sample to `sink` as it is made (a live pipe
@@ -373,6 +383,7 @@ pub fn track_reader(
         let start = std::time::Instant::now();
         let result = tracker.frame(t, &frame);
         run.latency_s.push(start.elapsed().as_secs_f64());
+        run.searched_px.push(result.searched_px);
         run.frames += 1;
         if let Some(s) = result.sample {
             sink(&s)?;
