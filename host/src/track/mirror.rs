@@ -29,12 +29,6 @@
 //! | 1 nat | 27 % of the way to the other |
 //! | 3 nats | 5 % |
 //!
-//! Where the two poses are far enough apart for the tag's whole picture to tell them
-//! ([`super::photo`]: each refined on every pixel of the tag), that picture's verdict is added
-//! to the corners' as the frame's evidence (the sum capped as a frame's evidence is): under
-//! motion blur the mirror's corners often fit better, and a kick at 1 m pitched 18° one way
-//! was reported pitched 18° the other.
-//!
 //! When several tags are in sight the pose has no mirror ([`super::fuse`]) and the branches
 //! collapse onto it ([`MirrorChooser::settle`]).
 
@@ -105,14 +99,11 @@ impl MirrorChooser {
     /// Reports one of `candidates` — the poses one tag admits at `t` seconds (body poses in
     /// the camera frame, each with its tag's RMS corner error in pixels) seen at `corners`
     /// (pixels) — and carries both on as branches; `None` when there is no candidate.
-    /// `picture`, when given, is the tag's whole picture's verdict on the candidates
-    /// ([`super::photo::evidence`]: nats, one per candidate), added to the corners' fit.
     pub fn choose(
         &mut self,
         t: f64,
         candidates: &[CameraPose],
         corners: &[[f64; 2]; 4],
-        picture: Option<&[f64]>,
     ) -> Option<CameraPose> {
         let lo = candidates
             .iter()
@@ -139,19 +130,14 @@ impl MirrorChooser {
         } else {
             (travel / FRESH_PX).min(1.0)
         };
-        let picture = picture.filter(|p| p.len() == candidates.len());
-        // The picture's verdict is one more look, beside the corners' (see the module text).
-        let misfit = |i: usize, c: &CameraPose| {
-            let corners = fresh_share * ((c.error * c.error - lo * lo) / noise).min(MAX_FRAME_NATS);
-            let seen = picture.and_then(|p| p.get(i)).copied().unwrap_or(0.0);
-            (seen + corners).min(MAX_FRAME_NATS)
+        let misfit = |c: &CameraPose| {
+            fresh_share * ((c.error * c.error - lo * lo) / noise).min(MAX_FRAME_NATS)
         };
         let step = TURN_RAD_S * dt.max(1e-3);
         let mut next: Vec<Branch> = candidates
             .iter()
-            .enumerate()
-            .filter(|(_, c)| c.error.is_finite())
-            .map(|(i, c)| {
+            .filter(|c| c.error.is_finite())
+            .map(|c| {
                 let q = c.quat();
                 let reach = if fresh {
                     0.0
@@ -166,7 +152,7 @@ impl MirrorChooser {
                 };
                 Branch {
                     pose: *c,
-                    cost: reach + misfit(i, c),
+                    cost: reach + misfit(c),
                 }
             })
             .collect();
@@ -261,7 +247,7 @@ mod tests {
         // Face-on: the two poses are one.
         for i in 0..10 {
             let t = i as f64 / 30.0;
-            m.choose(t, &[pose(0.5, 0.05), pose(-0.5, 0.06)], &corners(0.0), None);
+            m.choose(t, &[pose(0.5, 0.05), pose(-0.5, 0.06)], &corners(0.0));
         }
         // The tag tilts to +20° as it moves 2 px a frame; its mirror sits at −20°. The first
         // frames after the parting favour the mirror, then the true pose fits better by the
@@ -276,7 +262,6 @@ mod tests {
                     t,
                     &[pose(-tilt, bad), pose(tilt, good)],
                     &corners(2.0 * i as f64),
-                    None,
                 )
                 .unwrap();
             reported.push(tilt_of(&out));
@@ -299,7 +284,6 @@ mod tests {
                     i as f64 / 30.0,
                     &[pose(-8.0, 0.04), pose(4.0, 0.1)],
                     &corners(0.01 * (i % 2) as f64),
-                    None,
                 )
                 .unwrap();
             assert!(tilt_of(&out) > -2.0, "frame {i}: {}", tilt_of(&out));
@@ -311,7 +295,6 @@ mod tests {
                     i as f64 / 30.0,
                     &[pose(-8.0, 0.04), pose(4.0, 0.1)],
                     &corners(3.0 * i as f64),
-                    None,
                 )
                 .unwrap()
             })
@@ -360,7 +343,6 @@ mod tests {
                     i as f64 / 30.0,
                     &[pose(tilt, good), pose(-tilt, bad)],
                     &corners(0.3 * (i % 2) as f64),
-                    None,
                 )
                 .unwrap();
             let hard = tilt_of(&cheapest(m.branches.iter()).unwrap().pose);
@@ -397,12 +379,7 @@ mod tests {
                 (0.05, 0.06)
             };
             let out = m
-                .choose(
-                    t,
-                    &[pose(12.0, a), pose(-12.0, b)],
-                    &corners(i as f64),
-                    None,
-                )
+                .choose(t, &[pose(12.0, a), pose(-12.0, b)], &corners(i as f64))
                 .unwrap();
             sides.push(tilt_of(&out) > 0.0);
         }
@@ -417,12 +394,12 @@ mod tests {
         m.settle(0.0, &pose(15.0, 0.1));
         // Next frame: a tie between 15° and its mirror; continuity keeps 15°.
         let c = corners(5.0);
-        let out = m.choose(1.0 / 30.0, &[pose(-15.0, 0.05), pose(15.0, 0.05)], &c, None);
+        let out = m.choose(1.0 / 30.0, &[pose(-15.0, 0.05), pose(15.0, 0.05)], &c);
         assert!(tilt_of(&out.unwrap()) > 0.0);
         // After a long gap the better fit alone decides.
-        let out = m.choose(2.0, &[pose(-15.0, 0.04), pose(15.0, 0.08)], &c, None);
+        let out = m.choose(2.0, &[pose(-15.0, 0.04), pose(15.0, 0.08)], &c);
         assert!(tilt_of(&out.unwrap()) < 0.0);
         // No candidate, no pose.
-        assert!(m.choose(2.1, &[], &c, None).is_none());
+        assert!(m.choose(2.1, &[], &c).is_none());
     }
 }
