@@ -80,6 +80,12 @@ pub fn bench() -> Result<()> {
     );
     figurine(&["track", "bench"])?;
     step(
+        "webcam tracker searching every frame whole, for what the region search saves \
+         (frame → sample and pixels searched against the run above): figurine track bench \
+         --whole-frames --rest-seconds 0",
+    );
+    figurine(&["track", "bench", "--whole-frames", "--rest-seconds", "0"])?;
+    step(
         "webcam tracker, the box rig with its top seen from a camera looking down 25 degrees \
          (told the tilt): figurine track bench --rig box --box-top 0.0925 --camera-tilt 25 \
          --rest-seconds 0",
