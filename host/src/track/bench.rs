@@ -19,7 +19,10 @@ use super::eval::{
 };
 use super::rig::{BoxSize, DEFAULT_BOX_M};
 use super::still::{run_still, still_report};
-use super::trial::{actions_of, kept_truths, knobs, reading_of, write_truths};
+use super::trial::{
+    actions_of, kept_truths, knobs, reading_of, steady_readings, write_truths, JITTER_DRAWS,
+    JITTER_LEVELS,
+};
 use crate::synth::{gesture, Action, Effort};
 
 /// Arguments of `figurine track bench`.
@@ -108,6 +111,10 @@ pub struct GestureRun {
     /// sample: what a tracker without error, but with the same gaps (the tag out of sight,
     /// lost), would give.
     pub gapped_actions: Vec<String>,
+    /// For each of [`JITTER_LEVELS`], how many of [`JITTER_DRAWS`] copies of the truth with
+    /// that white jitter are read as the truth is: how steadily the recognizer reads the
+    /// gesture under any tracker's jitter, whatever this tracker does.
+    pub steady: Vec<u32>,
     /// Tracking time per frame (detection and pose), seconds.
     pub latency_s: Vec<f64>,
     /// Pixels the detector searched per frame.
@@ -153,6 +160,7 @@ pub fn run_gesture(
             .collect(),
     };
     let gapped_actions = actions_of(&gapped)?;
+    let steady = steady_readings(&truth, &truth_actions, seed)?;
     if dir.join("keep").exists() {
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;
@@ -165,6 +173,7 @@ pub fn run_gesture(
         truth_edits,
         tracked_actions,
         gapped_actions,
+        steady,
         latency_s: run.latency_s,
         searched_px: run.searched_px,
     })
@@ -307,6 +316,23 @@ pub fn report(runs: &[GestureRun]) -> String {
         share(gaps_only),
         share(error_only)
     );
+    // The recognizer's own steadiness bounds what any tracker can reach: a gesture near its
+    // pattern's edge tips under a tenth of a millimetre.
+    let _ = write!(
+        out,
+        "  the truth with white jitter alone (each sample moved and turned afresh, {JITTER_DRAWS} \
+         draws, mean):"
+    );
+    for (level, (pos_mm, ori_deg)) in JITTER_LEVELS.iter().enumerate() {
+        let same: u32 = runs.iter().filter_map(|r| r.steady.get(level)).sum();
+        let mean = f64::from(same) / JITTER_DRAWS as f64;
+        let _ = write!(
+            out,
+            " σ {pos_mm} mm and {ori_deg}°, the same in {mean:.2} ({:.1} %);",
+            100.0 * mean / runs.len().max(1) as f64
+        );
+    }
+    let _ = writeln!(out);
     // Against what was played: the tracked log may read the action where the truth misreads
     // it, and the other way round.
     let played = |r: &&GestureRun, read: &[String]| read == [r.action.name()];
@@ -510,6 +536,7 @@ mod tests {
             truth_edits: 0,
             tracked_actions: names(tracked),
             gapped_actions: names(gapped),
+            steady: vec![JITTER_DRAWS as u32, 1],
             latency_s: vec![0.001],
             searched_px: vec![5_000],
         }
@@ -529,6 +556,11 @@ mod tests {
         assert!(text.contains("leave it the same in 2 (66.7 %)"), "{text}");
         assert!(text.contains("in 2 (66.7 %)\n"), "{text}");
         assert!(text.contains("truth with the gaps [\"turn\"]"), "{text}");
+        // Every draw at the first level, one of four at the second, for each of the three.
+        assert!(
+            text.contains("σ 0.3 mm and 0.15°, the same in 3.00 (100.0 %); σ 1 mm and 0.5°, the same in 0.75 (25.0 %);"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! What one rendered trial of `figurine track bench` shares with the others: the motion the
 //! generator draws for it, the truths of a kept video (written beside it for `--keep`, read
-//! back for `--reuse`), and what the shipped library reads from a log.
+//! back for `--reuse`), what the shipped library reads from a log, and how steadily it reads
+//! the truth under a tracker's white jitter.
 
 use std::fmt::Write as _;
 
@@ -8,8 +9,20 @@ use anyhow::{Context, Result};
 
 use super::eval::{tags_in_sight, FrameTruth, Setup};
 use super::render::Scene;
+use crate::poselog::{PoseLog, PoseSample};
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
+use crate::synth::rng::{Stream, SynthRng};
 use crate::synth::{Knobs, Range};
+
+/// White jitter added to the truth to tell how steadily the recognizer reads it: (position σ
+/// per axis, mm; orientation σ about each axis, °). The first is about the tracked log's own
+/// jitter at rest (the bench's "tracked jitter at rest": 0.1–0.4 mm, 0.10–0.15° at 0.5–1 m);
+/// the second, about a tag near a webcam (the README's `webcam-near` level: 0.5–2 mm,
+/// 0.2–0.3°).
+pub const JITTER_LEVELS: [(f64, f64); 2] = [(0.3, 0.15), (1.0, 0.5)];
+
+/// Draws of the jitter per gesture and level (one draw's count moves by a gesture or two).
+pub const JITTER_DRAWS: u64 = 4;
 
 /// The generator's knobs for tracked gestures: clean truth at 240 Hz (the renderer blurs
 /// between samples), small enough to stay in view at half a metre, a toy held a little
@@ -25,18 +38,60 @@ pub fn knobs() -> Knobs {
 }
 
 /// The actions the shipped library and effort model read from `log`.
-pub fn actions_of(log: &crate::poselog::PoseLog) -> Result<Vec<String>> {
+pub fn actions_of(log: &PoseLog) -> Result<Vec<String>> {
     Ok(reading_of(log)?.0)
 }
 
 /// The actions the shipped library and effort model read from `log`, and the most edits any
 /// of them needed to match its pattern (0 when every one matched exactly, or none was read).
-pub fn reading_of(log: &crate::poselog::PoseLog) -> Result<(Vec<String>, u32)> {
+pub fn reading_of(log: &PoseLog) -> Result<(Vec<String>, u32)> {
     let (lib, blob) = load_library(None)?;
     let effort_model = load_effort(None)?;
     let records = simulate_log(log, &lib.names(), &blob, Some(effort_model))?.records;
     let edits = records.iter().map(|r| r.distance).max().unwrap_or(0);
     Ok((records.into_iter().map(|r| r.action).collect(), edits))
+}
+
+/// `log` with white jitter drawn from `seed`: every sample's position moved by a normal σ
+/// `pos_mm` on each axis, and its orientation turned by a normal σ `ori_deg` about each of the
+/// figurine's own axes.
+pub fn jittered(log: &PoseLog, pos_mm: f64, ori_deg: f64, seed: u64) -> PoseLog {
+    let mut rng = SynthRng::new(seed, Stream::Sensor);
+    let (p, o) = (pos_mm / 1000.0, ori_deg.to_radians());
+    let samples = log
+        .samples
+        .iter()
+        .map(|s| {
+            let pos = s.pos.map(|x| x + p * rng.normal());
+            let turn = glam::DVec3::new(rng.normal(), rng.normal(), rng.normal()) * o;
+            let [w, x, y, z] = s.quat;
+            let q = glam::DQuat::from_xyzw(x, y, z, w) * glam::DQuat::from_scaled_axis(turn);
+            PoseSample {
+                t: s.t,
+                pos,
+                quat: [q.w, q.x, q.y, q.z],
+            }
+        })
+        .collect();
+    PoseLog { samples }
+}
+
+/// For each of [`JITTER_LEVELS`], how many of [`JITTER_DRAWS`] jittered copies of `truth` the
+/// shipped library reads as `reading` (what it reads from `truth` itself); `seed` draws them.
+pub fn steady_readings(truth: &PoseLog, reading: &[String], seed: u64) -> Result<Vec<u32>> {
+    JITTER_LEVELS
+        .iter()
+        .enumerate()
+        .map(|(level, &(pos_mm, ori_deg))| {
+            (0..JITTER_DRAWS).try_fold(0, |same, draw| {
+                let draw_seed = seed
+                    .wrapping_mul(JITTER_LEVELS.len() as u64 * JITTER_DRAWS)
+                    .wrapping_add(level as u64 * JITTER_DRAWS + draw);
+                let log = jittered(truth, pos_mm, ori_deg, draw_seed);
+                Ok(same + u32::from(actions_of(&log)? == reading))
+            })
+        })
+        .collect()
 }
 
 /// What each frame of `video` showed, when `reuse` asks for a kept video and its truths were
@@ -101,7 +156,7 @@ pub fn read_truths(
                 .collect::<Result<_, _>>()
                 .with_context(|| format!("{}: {line}", path.display()))?;
             anyhow::ensure!(v.len() == 11, "{}: {line}", path.display());
-            let pose = crate::poselog::PoseSample {
+            let pose = PoseSample {
                 t: v[10],
                 pos: [v[1], v[2], v[3]],
                 quat: [v[4], v[5], v[6], v[7]],
@@ -141,6 +196,68 @@ mod tests {
     use crate::track::detect::Family;
     use crate::track::eval::scene;
 
+    /// A figurine held still for `n` frames at 30 Hz, turned a radian about its up axis.
+    fn held(n: usize) -> PoseLog {
+        let q = glam::DQuat::from_rotation_y(1.0);
+        PoseLog {
+            samples: (0..n)
+                .map(|i| PoseSample {
+                    t: i as f64 / 30.0,
+                    pos: [0.1, 0.2, -0.7],
+                    quat: [q.w, q.x, q.y, q.z],
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn jitter_has_the_stated_spread_in_position_and_orientation() {
+        let log = held(4000);
+        let noisy = jittered(&log, 1.0, 0.5, 7);
+        assert_eq!(noisy, jittered(&log, 1.0, 0.5, 7), "seeded");
+        assert_ne!(noisy, jittered(&log, 1.0, 0.5, 8));
+        let n = log.samples.len() as f64;
+        let (mut pos, mut ori) = (0.0, 0.0);
+        for (a, b) in log.samples.iter().zip(&noisy.samples) {
+            assert_eq!(a.t, b.t);
+            pos += (0..3).map(|k| (b.pos[k] - a.pos[k]).powi(2)).sum::<f64>();
+            let qa = glam::DQuat::from_xyzw(a.quat[1], a.quat[2], a.quat[3], a.quat[0]);
+            let qb = glam::DQuat::from_xyzw(b.quat[1], b.quat[2], b.quat[3], b.quat[0]);
+            ori += qa.angle_between(qb).powi(2);
+        }
+        // Per axis: the three axes' mean square, a third of the sum.
+        let pos_mm = (pos / n / 3.0).sqrt() * 1000.0;
+        let ori_deg = (ori / n / 3.0).sqrt().to_degrees();
+        assert!((pos_mm - 1.0).abs() < 0.05, "{pos_mm} mm");
+        assert!((ori_deg - 0.5).abs() < 0.025, "{ori_deg}°");
+        // No jitter, no change.
+        let still = jittered(&log, 0.0, 0.0, 7);
+        for (a, b) in log.samples.iter().zip(&still.samples) {
+            assert_eq!(a.pos, b.pos);
+            assert!(a
+                .quat
+                .iter()
+                .zip(b.quat)
+                .all(|(x, y)| (x - y).abs() < 1e-12));
+        }
+    }
+
+    #[test]
+    fn a_held_figurine_is_read_as_nothing_under_every_jitter_level() {
+        // Nothing is read from the held pose, and nothing from any jittered copy of it.
+        let log = held(90);
+        let (reading, _) = reading_of(&log).unwrap();
+        assert!(reading.is_empty(), "{reading:?}");
+        let steady = steady_readings(&log, &reading, 3).unwrap();
+        assert_eq!(steady, vec![JITTER_DRAWS as u32; JITTER_LEVELS.len()]);
+        // Against a reading it does not give, no draw agrees.
+        let walk = vec!["walk".to_string()];
+        assert_eq!(
+            steady_readings(&log, &walk, 3).unwrap(),
+            vec![0; JITTER_LEVELS.len()]
+        );
+    }
+
     #[test]
     fn kept_truths_read_back_and_refuse_another_setup() {
         let dir = std::env::temp_dir().join(format!("figurine-trial-{}", std::process::id()));
@@ -149,7 +266,7 @@ mod tests {
         let setup = Setup::default();
         let truths = vec![FrameTruth {
             t: 0.1,
-            pose: crate::poselog::PoseSample {
+            pose: PoseSample {
                 t: 3.1,
                 pos: [0.1, -0.2, -0.7],
                 quat: [1.0, 0.0, 0.0, 0.0],
@@ -163,7 +280,7 @@ mod tests {
         // Written as in sight but the tag is off the picture's left edge: out of sight.
         let off = FrameTruth {
             hidden: false,
-            pose: crate::poselog::PoseSample {
+            pose: PoseSample {
                 pos: [-0.45, 0.0, -0.7],
                 ..truths[0].pose
             },
