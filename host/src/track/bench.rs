@@ -14,8 +14,8 @@ use clap::Args;
 
 use super::detect::Family;
 use super::eval::{
-    compare, place, quantile, quat, render_video, scene, still_noise, summarize, track_video,
-    truth_log, FrameError, Noise, Setup, Summary, Tracking,
+    compare, place, quantile, quat, render_video, scene, still_noise, summarize, tag_speeds,
+    track_video, truth_log, FrameError, Noise, Setup, Summary, Tracking,
 };
 use super::rig::{BoxSize, DEFAULT_BOX_M};
 use super::still::{run_still, still_report};
@@ -100,6 +100,8 @@ pub struct GestureRun {
     pub distance: f64,
     /// Every frame compared.
     pub frames: Vec<FrameError>,
+    /// How fast each frame's tags moved, m/s ([`super::eval::tag_speeds`]; one per frame).
+    pub tag_speeds: Vec<f64>,
     /// Actions the recognizer read from the truth at the camera's frame times.
     pub truth_actions: Vec<String>,
     /// The most edits any of those needed to match its pattern (0: all exact): how near the
@@ -148,6 +150,7 @@ pub fn run_gesture(
     };
     let run = track_video(setup, Family::Tag36h11, 0, &video, how)?;
     let frames = compare(&truths, &run.log, setup.camera());
+    let tag_speeds = tag_speeds(&sc.body, &truths);
     let truth = truth_log(&truths);
     let (truth_actions, truth_edits) = reading_of(&truth)?;
     let tracked_actions = actions_of(&run.log)?;
@@ -169,6 +172,7 @@ pub fn run_gesture(
         action,
         distance: setup.distance,
         frames,
+        tag_speeds,
         truth_actions,
         truth_edits,
         tracked_actions,
@@ -256,6 +260,16 @@ pub fn report(runs: &[GestureRun]) -> String {
         (1.0, 9.0),
     ];
     binned(&mut out, &by_speed, &speeds, hundredths);
+    // A turning figurine's tags outrun its centre: the same frames by how fast its tags moved.
+    let _ = writeln!(
+        out,
+        "\nby the tags' speed (m/s: the fastest corner of any tag)\n| tags' speed {head}"
+    );
+    let by_tag_speed: Vec<_> = runs
+        .iter()
+        .flat_map(|r| r.frames.iter().zip(r.tag_speeds.iter().copied()))
+        .collect();
+    binned(&mut out, &by_tag_speed, &speeds, hundredths);
     // Motion blur grows with how fast the tag's face turns as much as with how fast it moves:
     // the lost frames' cause shows by turn rate, and at speed without turning.
     let turning: Vec<(&FrameError, f64)> =
@@ -532,6 +546,7 @@ mod tests {
             action: Action::Walk,
             distance: 0.5,
             frames: Vec::new(),
+            tag_speeds: Vec::new(),
             truth_actions: names(truth),
             truth_edits: 0,
             tracked_actions: names(tracked),

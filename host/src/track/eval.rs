@@ -148,6 +148,40 @@ pub struct FrameTruth {
     pub hidden: bool,
 }
 
+/// How fast each frame's tags move, m/s: the fastest corner of any of the body's tags, from
+/// the frames either side (one-sided at the ends). A turning figurine's tags move faster than
+/// its centre ([`FrameTruth::speed`]), and that motion is what smears their picture.
+pub fn tag_speeds(body: &Body, truths: &[FrameTruth]) -> Vec<f64> {
+    let half = body.tag_size / 2.0;
+    let corners = |pose: &PoseSample| -> Vec<DVec3> {
+        let (pos, q) = (DVec3::from_array(pose.pos), quat(pose));
+        body.panels
+            .iter()
+            .filter(|p| p.tag.is_some())
+            .flat_map(|p| {
+                let (centre, pq) = body.panel_pose(p, pos, q);
+                [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                    .map(|(u, v)| centre + pq * DVec3::new(u * half, v * half, 0.0))
+            })
+            .collect()
+    };
+    let last = truths.len().saturating_sub(1);
+    (0..truths.len())
+        .map(|i| {
+            let (a, b) = (&truths[i.saturating_sub(1)], &truths[(i + 1).min(last)]);
+            let dt = b.t - a.t;
+            if dt <= 0.0 {
+                return 0.0;
+            }
+            corners(&a.pose)
+                .iter()
+                .zip(corners(&b.pose))
+                .map(|(p, q)| (q - *p).length() / dt)
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
 /// A tag turned further than this from the camera (degrees between its normal and the line
 /// of sight) is out of sight: seen that edge-on, 4 cm is a sliver.
 pub const MAX_VIEW_DEG: f64 = 70.0;
@@ -561,6 +595,58 @@ mod tests {
         // The frame's edge is 0.404 m off-centre at 0.7 m: the tag's half (2 cm) crosses it.
         assert_eq!(tags_in_sight(&sc, &at(0.37, 0.0)), 1);
         assert_eq!(tags_in_sight(&sc, &at(0.395, 0.0)), 0, "cut by the edge");
+    }
+
+    #[test]
+    fn a_turning_figurine_s_tags_outrun_its_centre() {
+        let sc = scene(&Setup::default(), Family::Tag36h11, 0).unwrap();
+        let frame = |i: u32, x: f64, yaw: f64| {
+            let q = DQuat::from_rotation_y(yaw);
+            let t = f64::from(i) / 30.0;
+            FrameTruth {
+                t,
+                pose: PoseSample {
+                    t: 10.0 + t,
+                    pos: [x, 0.0, -0.7],
+                    quat: [q.w, q.x, q.y, q.z],
+                },
+                speed: 0.0,
+                hidden: false,
+            }
+        };
+        // Gliding at 0.3 m/s: every corner moves as the centre does.
+        let glide: Vec<_> = (0..5)
+            .map(|i| frame(i, 0.3 * f64::from(i) / 30.0, 0.0))
+            .collect();
+        for v in tag_speeds(&sc.body, &glide) {
+            assert!((v - 0.3).abs() < 1e-9, "{v}");
+        }
+        // Spinning in place at 10 rad/s: the corner farthest from the axis, over the chord
+        // between the frames either side (one-sided, a single step, at the ends).
+        let spin: Vec<_> = (0..5)
+            .map(|i| frame(i, 0.0, 10.0 * f64::from(i) / 30.0))
+            .collect();
+        let panel = sc.body.panels.iter().find(|p| p.tag.is_some()).unwrap();
+        let half = sc.body.tag_size / 2.0;
+        let reach = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(u, v)| {
+                let c = panel.centre + panel.rotation * DVec3::new(u * half, v * half, 0.0);
+                c.x.hypot(c.z)
+            })
+            .fold(0.0, f64::max);
+        let chord = |turn: f64, dt: f64| 2.0 * reach * (turn / 2.0).sin() / dt;
+        let speeds = tag_speeds(&sc.body, &spin);
+        assert!(
+            (speeds[2] - chord(20.0 / 30.0, 2.0 / 30.0)).abs() < 1e-9,
+            "{speeds:?}"
+        );
+        assert!(
+            (speeds[0] - chord(10.0 / 30.0, 1.0 / 30.0)).abs() < 1e-9,
+            "{speeds:?}"
+        );
+        assert!(speeds[2] > 9.0 * reach, "{speeds:?}");
+        assert_eq!(tag_speeds(&sc.body, &[]), Vec::<f64>::new());
     }
 
     #[test]
