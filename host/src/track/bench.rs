@@ -378,15 +378,24 @@ pub fn report(runs: &[GestureRun]) -> String {
         let _ = write!(out, " {label}, the same in {same} of {n};");
     }
     let _ = writeln!(out);
+    // Each gesture read otherwise, with how steadily its truth reads under the jitter levels:
+    // one that tips under a third of a millimetre lies at its pattern's edge.
     for r in runs.iter().filter(|r| r.truth_actions != r.tracked_actions) {
+        let steady: Vec<String> = r
+            .steady
+            .iter()
+            .map(|n| format!("{n}/{JITTER_DRAWS}"))
+            .collect();
         let _ = writeln!(
             out,
-            "  {} at {:.2} m: truth {:?}, tracked {:?}, truth with the gaps {:?}",
+            "  {} at {:.2} m: truth {:?}, tracked {:?}, truth with the gaps {:?}, truth with \
+             white jitter the same in {} draws",
             r.action.name(),
             r.distance,
             r.truth_actions,
             r.tracked_actions,
-            r.gapped_actions
+            r.gapped_actions,
+            steady.join(", ")
         );
     }
     let mut lat: Vec<f64> = runs.iter().flat_map(|r| r.latency_s.clone()).collect();
@@ -570,7 +579,12 @@ mod tests {
         assert!(text.contains("in 1 of 3 gestures"), "{text}");
         assert!(text.contains("leave it the same in 2 (66.7 %)"), "{text}");
         assert!(text.contains("in 2 (66.7 %)\n"), "{text}");
-        assert!(text.contains("truth with the gaps [\"turn\"]"), "{text}");
+        assert!(
+            text.contains(
+                "truth with the gaps [\"turn\"], truth with white jitter the same in 4/4, 1/4 draws"
+            ),
+            "{text}"
+        );
         // Every draw at the first level, one of four at the second, for each of the three.
         assert!(
             text.contains("σ 0.3 mm and 0.15°, the same in 3.00 (100.0 %); σ 1 mm and 0.5°, the same in 0.75 (25.0 %);"),
