@@ -20,8 +20,7 @@ use super::eval::{
 use super::rig::{BoxSize, DEFAULT_BOX_M};
 use super::still::{run_still, still_report};
 use super::trial::{
-    actions_of, kept_truths, knobs, reading_of, steady_readings, write_truths, JITTER_DRAWS,
-    JITTER_LEVELS,
+    kept_truths, knobs, steady_readings, write_truths, Reader, JITTER_DRAWS, JITTER_LEVELS,
 };
 use crate::synth::{gesture, Action, Effort};
 
@@ -152,8 +151,9 @@ pub fn run_gesture(
     let frames = compare(&truths, &run.log, setup.camera());
     let tag_speeds = tag_speeds(&sc.body, &truths);
     let truth = truth_log(&truths);
-    let (truth_actions, truth_edits) = reading_of(&truth)?;
-    let tracked_actions = actions_of(&run.log)?;
+    let reader = Reader::shipped()?;
+    let (truth_actions, truth_edits) = reader.reading(&truth)?;
+    let tracked_actions = reader.actions(&run.log)?;
     let gapped = crate::poselog::PoseLog {
         samples: truth
             .samples
@@ -162,8 +162,8 @@ pub fn run_gesture(
             .copied()
             .collect(),
     };
-    let gapped_actions = actions_of(&gapped)?;
-    let steady = steady_readings(&truth, &truth_actions, seed)?;
+    let gapped_actions = reader.actions(&gapped)?;
+    let steady = steady_readings(&reader, &truth, &truth_actions, seed)?;
     if dir.join("keep").exists() {
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;

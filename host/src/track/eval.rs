@@ -165,18 +165,19 @@ pub fn tag_speeds(body: &Body, truths: &[FrameTruth]) -> Vec<f64> {
             })
             .collect()
     };
+    let at: Vec<Vec<DVec3>> = truths.iter().map(|f| corners(&f.pose)).collect();
     let last = truths.len().saturating_sub(1);
     (0..truths.len())
         .map(|i| {
-            let (a, b) = (&truths[i.saturating_sub(1)], &truths[(i + 1).min(last)]);
-            let dt = b.t - a.t;
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
+            let dt = truths[b].t - truths[a].t;
             if dt <= 0.0 {
                 return 0.0;
             }
-            corners(&a.pose)
+            at[a]
                 .iter()
-                .zip(corners(&b.pose))
-                .map(|(p, q)| (q - *p).length() / dt)
+                .zip(&at[b])
+                .map(|(p, q)| (*q - *p).length() / dt)
                 .fold(0.0, f64::max)
         })
         .collect()

@@ -13,6 +13,7 @@ use crate::poselog::{PoseLog, PoseSample};
 use crate::recognize::simulate::{load_effort, load_library, simulate_log};
 use crate::synth::rng::{Stream, SynthRng};
 use crate::synth::{Knobs, Range};
+use figurine_recognizer::bayes::EffortModel;
 
 /// White jitter added to the truth to tell how steadily the recognizer reads it: (position σ
 /// per axis, mm; orientation σ about each axis, °). The first is about the tracked log's own
@@ -37,19 +38,41 @@ pub fn knobs() -> Knobs {
     }
 }
 
-/// The actions the shipped library and effort model read from `log`.
-pub fn actions_of(log: &PoseLog) -> Result<Vec<String>> {
-    Ok(reading_of(log)?.0)
+/// The shipped library and effort model, loaded once to read many logs.
+pub struct Reader {
+    names: Vec<String>,
+    blob: Vec<u8>,
+    effort: EffortModel,
 }
 
-/// The actions the shipped library and effort model read from `log`, and the most edits any
-/// of them needed to match its pattern (0 when every one matched exactly, or none was read).
-pub fn reading_of(log: &PoseLog) -> Result<(Vec<String>, u32)> {
-    let (lib, blob) = load_library(None)?;
-    let effort_model = load_effort(None)?;
-    let records = simulate_log(log, &lib.names(), &blob, Some(effort_model))?.records;
-    let edits = records.iter().map(|r| r.distance).max().unwrap_or(0);
-    Ok((records.into_iter().map(|r| r.action).collect(), edits))
+impl Reader {
+    /// Loads the shipped library and effort model.
+    pub fn shipped() -> Result<Self> {
+        let (lib, blob) = load_library(None)?;
+        Ok(Reader {
+            names: lib.names(),
+            blob,
+            effort: load_effort(None)?,
+        })
+    }
+
+    /// The actions read from `log`, and the most edits any of them needed to match its
+    /// pattern (0 when every one matched exactly, or none was read).
+    pub fn reading(&self, log: &PoseLog) -> Result<(Vec<String>, u32)> {
+        let records = simulate_log(log, &self.names, &self.blob, Some(self.effort))?.records;
+        let edits = records.iter().map(|r| r.distance).max().unwrap_or(0);
+        Ok((records.into_iter().map(|r| r.action).collect(), edits))
+    }
+
+    /// The actions read from `log`.
+    pub fn actions(&self, log: &PoseLog) -> Result<Vec<String>> {
+        Ok(self.reading(log)?.0)
+    }
+}
+
+/// The actions the shipped library and effort model read from `log`.
+pub fn actions_of(log: &PoseLog) -> Result<Vec<String>> {
+    Reader::shipped()?.actions(log)
 }
 
 /// `log` with white jitter drawn from `seed`: every sample's position moved by a normal σ
@@ -76,9 +99,14 @@ pub fn jittered(log: &PoseLog, pos_mm: f64, ori_deg: f64, seed: u64) -> PoseLog 
     PoseLog { samples }
 }
 
-/// For each of [`JITTER_LEVELS`], how many of [`JITTER_DRAWS`] jittered copies of `truth` the
-/// shipped library reads as `reading` (what it reads from `truth` itself); `seed` draws them.
-pub fn steady_readings(truth: &PoseLog, reading: &[String], seed: u64) -> Result<Vec<u32>> {
+/// For each of [`JITTER_LEVELS`], how many of [`JITTER_DRAWS`] jittered copies of `truth`
+/// `reader` reads as `reading` (what it reads from `truth` itself); `seed` draws them.
+pub fn steady_readings(
+    reader: &Reader,
+    truth: &PoseLog,
+    reading: &[String],
+    seed: u64,
+) -> Result<Vec<u32>> {
     JITTER_LEVELS
         .iter()
         .enumerate()
@@ -88,7 +116,7 @@ pub fn steady_readings(truth: &PoseLog, reading: &[String], seed: u64) -> Result
                     .wrapping_mul(JITTER_LEVELS.len() as u64 * JITTER_DRAWS)
                     .wrapping_add(level as u64 * JITTER_DRAWS + draw);
                 let log = jittered(truth, pos_mm, ori_deg, draw_seed);
-                Ok(same + u32::from(actions_of(&log)? == reading))
+                Ok(same + u32::from(reader.actions(&log)? == reading))
             })
         })
         .collect()
@@ -246,14 +274,15 @@ mod tests {
     fn a_held_figurine_is_read_as_nothing_under_every_jitter_level() {
         // Nothing is read from the held pose, and nothing from any jittered copy of it.
         let log = held(90);
-        let (reading, _) = reading_of(&log).unwrap();
+        let reader = Reader::shipped().unwrap();
+        let (reading, _) = reader.reading(&log).unwrap();
         assert!(reading.is_empty(), "{reading:?}");
-        let steady = steady_readings(&log, &reading, 3).unwrap();
+        let steady = steady_readings(&reader, &log, &reading, 3).unwrap();
         assert_eq!(steady, vec![JITTER_DRAWS as u32; JITTER_LEVELS.len()]);
         // Against a reading it does not give, no draw agrees.
         let walk = vec!["walk".to_string()];
         assert_eq!(
-            steady_readings(&log, &walk, 3).unwrap(),
+            steady_readings(&reader, &log, &walk, 3).unwrap(),
             vec![0; JITTER_LEVELS.len()]
         );
     }
