@@ -38,6 +38,8 @@ pub struct TagSeen {
     /// Every body pose the tag admits — its best fit and, when it differs, its mirror — each
     /// with the tag's RMS corner error (pixels), the best first.
     pub candidates: Vec<CameraPose>,
+    /// The tag's own camera-frame poses behind [`Self::candidates`], in the same order.
+    pub tag_candidates: Vec<CameraPose>,
 }
 
 impl TagSeen {
@@ -67,9 +69,12 @@ pub fn solve_tags(rig: &Rig, found: Vec<Detection>, k: &Intrinsics) -> Vec<TagSe
             let face = rig.face(d.id)?;
             let tags = solve_candidates(&d.corners, rig.tag_size, k);
             let tag = *tags.first()?;
-            let candidates: Vec<CameraPose> = tags
-                .iter()
+            let tag_candidates: Vec<CameraPose> = tags
+                .into_iter()
                 .filter(|c| c.error <= MAX_POSE_ERROR_PX || c.error == tag.error)
+                .collect();
+            let candidates: Vec<CameraPose> = tag_candidates
+                .iter()
                 .map(|c| face.body_from_tag(c))
                 .collect();
             Some(TagSeen {
@@ -77,6 +82,7 @@ pub fn solve_tags(rig: &Rig, found: Vec<Detection>, k: &Intrinsics) -> Vec<TagSe
                 tag,
                 body: candidates[0],
                 candidates,
+                tag_candidates,
             })
         })
         .collect()
@@ -95,6 +101,11 @@ pub enum Fused {
         candidates: Vec<CameraPose>,
         /// The tag's corners, pixels.
         corners: [[f64; 2]; 4],
+        /// The tag's id.
+        id: u32,
+        /// The tag's own poses behind `candidates`, in the same order (for
+        /// [`super::photo::evidence`]).
+        tag_poses: Vec<CameraPose>,
     },
 }
 
@@ -107,6 +118,8 @@ pub fn fuse(rig: &Rig, seen: &[TagSeen], k: &Intrinsics) -> Option<Fused> {
         .map(|s| Fused::Lone {
             candidates: s.candidates.clone(),
             corners: s.detection.corners,
+            id: s.detection.id,
+            tag_poses: s.tag_candidates.clone(),
         })?;
     if trusted.len() < 2 {
         return Some(largest);

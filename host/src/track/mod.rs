@@ -19,6 +19,7 @@ pub mod eval;
 pub mod fuse;
 pub mod level;
 pub mod mirror;
+pub mod photo;
 pub mod pnp;
 pub mod pose;
 pub mod print;

@@ -111,51 +111,73 @@ fn rms(r: &[f64]) -> f64 {
     (r.iter().map(|v| v * v).sum::<f64>() / (r.len() / 2).max(1) as f64).sqrt()
 }
 
-/// Levenberg–Marquardt on a pose (a rotation-vector step on the left, and the translation)
-/// that takes object points `obj` (metres) to pixels `px`; returns the refined pose and its
-/// RMS point error in pixels. Four corners of one tag, or the corners of every tag of a rig
-/// in sight (points on several planes: no mirror pose to confuse).
-pub fn refine(
+/// How [`least_squares`] searches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Search {
+    /// Most Levenberg–Marquardt steps.
+    pub steps: usize,
+    /// Tries per step, the damping ten times larger after each that did not lower the cost.
+    pub tries: usize,
+    /// Damping at the start, and the least it falls to (×0.3 after each step taken).
+    pub damping: (f64, f64),
+    /// Least fall in cost for a step to count as progress: below it the search stops.
+    pub min_gain: f64,
+}
+
+/// The residuals' derivatives by each of a pose's six parameters — a rotation vector on the
+/// left (radians), then the translation (metres) — one column each.
+pub type Jacobian = [Vec<f64>; 6];
+
+/// [`Jacobian`] by forward differences from the residuals `r` at (q, t): steps of `h.0`
+/// radians and `h.1` metres. `None` when a stepped pose has no residuals.
+pub fn numerical_jacobian(
+    residuals: &impl Fn(DQuat, DVec3) -> Option<Vec<f64>>,
+    q: DQuat,
+    t: DVec3,
+    r: &[f64],
+    h: (f64, f64),
+) -> Option<Jacobian> {
+    let mut jac: Jacobian = Default::default();
+    for (j, col) in jac.iter_mut().enumerate() {
+        let h = if j < 3 { h.0 } else { h.1 };
+        let mut d = [0.0; 6];
+        d[j] = h;
+        let (q1, t1) = step(q, t, &d);
+        let r1 = residuals(q1, t1)?;
+        *col = r1.iter().zip(r).map(|(a, b)| (a - b) / h).collect();
+    }
+    Some(jac)
+}
+
+/// Levenberg–Marquardt on a pose — a rotation-vector step on the left, and the translation:
+/// lowers `cost` of the `residuals` a pose gives, the `jacobian` of them at a pose (given its
+/// residuals) guiding each step, taking a step only where they exist, the cost falls and
+/// `accept` takes the new translation. Returns the pose and its residuals; `None` when the
+/// start or a Jacobian cannot be had.
+pub fn least_squares(
     mut q: DQuat,
     mut t: DVec3,
-    obj: &[DVec3],
-    px: &[DVec2],
-    k: &Intrinsics,
-) -> (DQuat, DVec3, f64) {
-    let n = 2 * obj.len().min(px.len());
-    let mut r = residuals(q, t, obj, px, k);
-    let mut cost = rms(&r);
-    let mut mu = 1e-3;
-    let apply = |q: DQuat, t: DVec3, d: &[f64; 6]| {
-        let w = DVec3::new(d[0], d[1], d[2]);
-        let dq = if w.length() > 0.0 {
-            DQuat::from_scaled_axis(w)
-        } else {
-            DQuat::IDENTITY
-        };
-        ((dq * q).normalize(), t + DVec3::new(d[3], d[4], d[5]))
-    };
-    for _ in 0..30 {
-        // Numerical Jacobian: 6 columns of n residuals.
-        let mut jac: [Vec<f64>; 6] = Default::default();
-        for (j, col) in jac.iter_mut().enumerate() {
-            let step = if j < 3 { 1e-6 } else { 1e-7 };
-            let mut d = [0.0; 6];
-            d[j] = step;
-            let (q1, t1) = apply(q, t, &d);
-            let r1 = residuals(q1, t1, obj, px, k);
-            *col = (0..n).map(|i| (r1[i] - r[i]) / step).collect();
-        }
+    search: &Search,
+    residuals: impl Fn(DQuat, DVec3) -> Option<Vec<f64>>,
+    jacobian: impl Fn(DQuat, DVec3, &[f64]) -> Option<Jacobian>,
+    cost_of: impl Fn(&[f64]) -> f64,
+    accept: impl Fn(DVec3) -> bool,
+) -> Option<(DQuat, DVec3, Vec<f64>)> {
+    let mut r = residuals(q, t)?;
+    let mut cost = cost_of(&r);
+    let mut mu = search.damping.0;
+    for _ in 0..search.steps {
+        let jac = jacobian(q, t, &r)?;
         let mut jtj = [[0.0; 6]; 6];
         let mut jtr = [0.0; 6];
         for a in 0..6 {
             for b in 0..6 {
-                jtj[a][b] = (0..n).map(|i| jac[a][i] * jac[b][i]).sum();
+                jtj[a][b] = jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum();
             }
-            jtr[a] = -(0..n).map(|i| jac[a][i] * r[i]).sum::<f64>();
+            jtr[a] = -jac[a].iter().zip(&r).map(|(x, y)| x * y).sum::<f64>();
         }
         let mut improved = false;
-        for _ in 0..8 {
+        for _ in 0..search.tries {
             let mut damped = jtj;
             for (a, row) in damped.iter_mut().enumerate() {
                 row[a] += mu * jtj[a][a].max(1e-9);
@@ -164,23 +186,71 @@ pub fn refine(
                 mu *= 10.0;
                 continue;
             };
-            let (q1, t1) = apply(q, t, &d);
-            let r1 = residuals(q1, t1, obj, px, k);
-            let c1 = rms(&r1);
-            if c1 < cost && t1.z > 0.0 {
-                let gain = cost - c1;
-                (q, t, r, cost) = (q1, t1, r1, c1);
-                mu = (mu * 0.3).max(1e-9);
-                improved = gain > 1e-9;
-                break;
+            let (q1, t1) = step(q, t, &d);
+            match residuals(q1, t1) {
+                Some(r1) if cost_of(&r1) < cost && accept(t1) => {
+                    let c1 = cost_of(&r1);
+                    improved = cost - c1 > search.min_gain;
+                    (q, t, r, cost) = (q1, t1, r1, c1);
+                    mu = (mu * 0.3).max(search.damping.1);
+                    break;
+                }
+                _ => mu *= 10.0,
             }
-            mu *= 10.0;
         }
         if !improved {
             break;
         }
     }
-    (q, t, cost)
+    Some((q, t, r))
+}
+
+/// Pose (q, t) moved by a rotation vector `d[0..3]` (on the left) and a translation `d[3..6]`.
+fn step(q: DQuat, t: DVec3, d: &[f64; 6]) -> (DQuat, DVec3) {
+    let w = DVec3::new(d[0], d[1], d[2]);
+    let dq = if w.length() > 0.0 {
+        DQuat::from_scaled_axis(w)
+    } else {
+        DQuat::IDENTITY
+    };
+    ((dq * q).normalize(), t + DVec3::new(d[3], d[4], d[5]))
+}
+
+/// How [`refine`] searches: up to 30 steps from a corner fit's pose.
+const CORNER_SEARCH: Search = Search {
+    steps: 30,
+    tries: 8,
+    damping: (1e-3, 1e-9),
+    min_gain: 1e-9,
+};
+/// Forward-difference steps of [`refine`]'s Jacobian: a microradian, a tenth of a micrometre.
+const CORNER_H: (f64, f64) = (1e-6, 1e-7);
+
+/// Levenberg–Marquardt on a pose that takes object points `obj` (metres) to pixels `px`
+/// ([`least_squares`] on the reprojection error); returns the refined pose and its RMS point
+/// error in pixels. Four corners of one tag, or the corners of every tag of a rig in sight
+/// (points on several planes: no mirror pose to confuse).
+pub fn refine(
+    q: DQuat,
+    t: DVec3,
+    obj: &[DVec3],
+    px: &[DVec2],
+    k: &Intrinsics,
+) -> (DQuat, DVec3, f64) {
+    let misfit = |q, t| Some(residuals(q, t, obj, px, k));
+    let fit = least_squares(
+        q,
+        t,
+        &CORNER_SEARCH,
+        misfit,
+        |q, t, r: &[f64]| numerical_jacobian(&misfit, q, t, r, CORNER_H),
+        rms,
+        |t| t.z > 0.0,
+    );
+    match fit {
+        Some((q, t, r)) => (q, t, rms(&r)),
+        None => (q, t, f64::INFINITY),
+    }
 }
 
 /// The other pose a flat square nearly equally explains: its normal mirrored about the line
