@@ -4,9 +4,10 @@
 //! sight — whose corners differ by hundredths of a pixel. One frame's fit cannot tell them
 //! apart reliably, but the true pose keeps fitting a little better frame after frame (on the
 //! track bench at 1 m: 0.05 px RMS against 0.11 px, over a dozen frames). So both are followed
-//! as branches, each carrying the cost of its best path so far: the corner misfit of every
-//! pose on it (the negative log-likelihood under the corner noise, measured as the fits go)
-//! plus the cost of the turns between its poses (a toy does not turn by tens of degrees in a
+//! as branches, each carrying the cost of its best path so far: the evidence against every
+//! pose on it — its corners' misfit (the negative log-likelihood under the corner noise,
+//! measured as the fits go) or, on a small tag, its picture's (the table below) — plus the
+//! cost of the turns between its poses (a toy does not turn by tens of degrees in a
 //! thirtieth of a second). A frame's fit counts in full only when the tag has moved since the
 //! last (a still tag shows the same biased picture again and again). The costs come from a
 //! forward Viterbi pass over the two branches. Near face-on the two poses are close, every
