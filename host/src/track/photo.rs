@@ -78,8 +78,7 @@ pub fn evidence(
     let fits = poses
         .iter()
         .map(|p| {
-            let (q, t) = problem.refine(p.quat(), DVec3::from_array(p.translation))?;
-            let r = problem.misfit(q, t)?;
+            let r = problem.refine(p.quat(), DVec3::from_array(p.translation))?;
             Some((sum_sq(&r), r))
         })
         .collect::<Option<Vec<(f64, Vec<f64>)>>>()?;
@@ -292,9 +291,9 @@ impl<'a> Problem<'a> {
         self.residuals(q, t, false).map(|(r, _)| r)
     }
 
-    /// The pose near (q, t) the picture fits best (step 4).
-    fn refine(&self, q: DQuat, t: DVec3) -> Option<(DQuat, DVec3)> {
-        let fit = least_squares(
+    /// The residuals of the pose near (q, t) the picture fits best (step 4).
+    fn refine(&self, q: DQuat, t: DVec3) -> Option<Vec<f64>> {
+        let (_, _, r) = least_squares(
             q,
             t,
             &PICTURE_SEARCH,
@@ -303,7 +302,7 @@ impl<'a> Problem<'a> {
             sum_sq,
             |_| true,
         )?;
-        Some((fit.0, fit.1))
+        Some(r)
     }
 }
 

@@ -187,16 +187,16 @@ pub fn least_squares(
                 continue;
             };
             let (q1, t1) = step(q, t, &d);
-            match residuals(q1, t1) {
-                Some(r1) if cost_of(&r1) < cost && accept(t1) => {
-                    let c1 = cost_of(&r1);
+            if let Some(r1) = residuals(q1, t1) {
+                let c1 = cost_of(&r1);
+                if c1 < cost && accept(t1) {
                     improved = cost - c1 > search.min_gain;
                     (q, t, r, cost) = (q1, t1, r1, c1);
                     mu = (mu * 0.3).max(search.damping.1);
                     break;
                 }
-                _ => mu *= 10.0,
             }
+            mu *= 10.0;
         }
         if !improved {
             break;
