@@ -23,7 +23,7 @@ use super::eval::{
     compare, place, quantile, quat, render_video, scene, track_video, truth_log, FrameError,
     FrameTruth, Setup, Tracking,
 };
-use super::trial::{actions_of, kept_truths, knobs, write_truths};
+use super::trial::{kept_truths, knobs, write_truths, Reader};
 use crate::poselog::PoseSample;
 use crate::synth::rest::{rest_log, RestKind, RestSpec, TRACKER_LEVELS};
 use crate::synth::Range;
@@ -104,11 +104,12 @@ pub fn run_still(
         truth.write_path(&video.with_extension("truth.csv"))?;
         run.log.write_path(&video.with_extension("tracked.csv"))?;
     }
+    let reader = Reader::shipped()?;
     Ok(StillRun {
         distance: setup.distance,
         seconds,
-        truth_actions: actions_of(&truth)?,
-        tracked_actions: actions_of(&run.log)?,
+        truth_actions: reader.actions(&truth)?,
+        tracked_actions: reader.actions(&run.log)?,
         tracked_turns_deg: turns_deg(&run.log.samples),
         truth_turns_deg: turns_deg(&kept),
         frames,

@@ -70,11 +70,6 @@ impl Reader {
     }
 }
 
-/// The actions the shipped library and effort model read from `log`.
-pub fn actions_of(log: &PoseLog) -> Result<Vec<String>> {
-    Reader::shipped()?.actions(log)
-}
-
 /// `log` with white jitter drawn from `seed`: every sample's position moved by a normal σ
 /// `pos_mm` on each axis, and its orientation turned by a normal σ `ori_deg` about each of the
 /// figurine's own axes.
